@@ -1,0 +1,11 @@
+//! Writers for other tools: pictures, ParaView, Blender, time series.
+
+pub mod slice_image;
+
+pub use slice_image::{label_colour, write_axial_slices};
+pub mod vtu;
+
+pub use vtu::{CellType, VtuMesh, write_atomic, write_pvd};
+pub mod body_vtu;
+
+pub use body_vtu::{BodyPositions, FatScalars, body_vtu, rest_vtu};

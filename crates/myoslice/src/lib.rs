@@ -1,0 +1,43 @@
+//! # myoslice
+//!
+//! A deformable human lower limb built from labelled anatomical slices (bone, muscle,
+//! fat) and moved by its own muscles, after Inaba, Miyazaki and Hasegawa, and beyond.
+//!
+//! The data flow runs one way: label volume → slices → contours → lattice → body model →
+//! simulation → frames. This crate holds all of it and is headless; the viewer, the
+//! Python package and the CLI are thin fronts over [`Simulation`].
+//!
+//! Frame and units: SI inside (m, kg, s, N, rad); +z superior, +y anterior, +x toward
+//! the subject's right. Slice data arrive in mm and are converted at the edge.
+#![warn(missing_docs)]
+
+pub mod contour;
+pub mod error;
+pub mod export;
+pub mod io;
+pub mod label_table;
+pub mod label_volume;
+pub mod lattice;
+pub mod phantom;
+pub mod report;
+pub mod slices;
+pub mod spatial;
+pub mod tracking;
+
+pub use error::{Error, Result};
+pub use label_table::{Label, LabelTable, TissueKind};
+pub use label_volume::LabelVolume;
+pub use lattice::{BoneMesh, BuildOptions, FatLattice, Lattice, MuscleLattice, StructureStats};
+pub use report::BuildReport;
+pub use slices::SliceReduction;
+
+/// The types most programs need.
+pub mod prelude {
+    pub use crate::error::{Error, Result};
+    pub use crate::io::{read_nifti, read_png_stack};
+    pub use crate::label_table::{LabelTable, TissueKind};
+    pub use crate::label_volume::LabelVolume;
+    pub use crate::lattice::{BuildOptions, Lattice};
+    pub use crate::phantom::Phantom;
+    pub use crate::slices::SliceReduction;
+}

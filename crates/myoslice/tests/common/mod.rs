@@ -1,0 +1,35 @@
+//! Shared helpers of the integration tests.
+#![allow(dead_code)]
+#![allow(clippy::unwrap_used)] // tests fail loudly by design
+
+use std::path::PathBuf;
+
+use myoslice::prelude::*;
+
+/// `../shared/data/visible-human/` relative to the workspace.
+pub fn vh_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/visible-human")
+}
+
+/// The Visible Human leg, or `None` (with a loud message) when the data are absent and
+/// `MYOSLICE_ALLOW_MISSING_DATA=1` says that is expected. Without that variable a missing
+/// data folder fails the test: it must never pass silently.
+pub fn vh_leg() -> Option<(LabelVolume, LabelTable)> {
+    let dir = vh_dir();
+    let vol = dir.join("vhf_left_leg_labels.nii.gz");
+    let lab = dir.join("vhf_left_leg_labels.json");
+    if !vol.exists() || !lab.exists() {
+        let msg = format!(
+            "Visible Human data not found at {} (expected ../shared beside the workspace)",
+            dir.display()
+        );
+        if std::env::var("MYOSLICE_ALLOW_MISSING_DATA").as_deref() == Ok("1") {
+            eprintln!("SKIPPED: {msg}");
+            return None;
+        }
+        panic!("{msg}; set MYOSLICE_ALLOW_MISSING_DATA=1 to skip the tests that need it");
+    }
+    let v = read_nifti(&vol).expect("the Visible Human volume loads as it is");
+    let t = LabelTable::from_path(&lab).expect("the Visible Human label table loads as it is");
+    Some((v, t))
+}

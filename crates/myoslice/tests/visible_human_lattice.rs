@@ -1,0 +1,95 @@
+//! The lattice built from the real Visible Human leg at the paper's reduction.
+
+#![allow(clippy::unwrap_used)] // tests fail loudly by design
+
+mod common;
+
+use myoslice::prelude::*;
+use myoslice::{BuildReport, TissueKind};
+
+#[test]
+fn visible_human_lattice_matches_voxel_volumes_and_region_shapes() {
+    let Some((volume, table)) = common::vh_leg() else {
+        return;
+    };
+    assert_eq!(volume.dims(), [218, 300, 861]);
+    assert_eq!(volume.spacing_mm(), [1.0, 1.0, 1.0]);
+    let lattice = Lattice::build(&volume, &table, &BuildOptions::default()).unwrap();
+    let report = BuildReport::measure(&volume, &lattice, "vh");
+    let mut failures = Vec::new();
+    for s in &report.structures {
+        let tol = if s.voxel_volume_cm3 >= 50.0 && s.kind != TissueKind::Fat {
+            0.05
+        } else {
+            0.10
+        };
+        if s.volume_error.abs() > tol {
+            failures.push(format!(
+                "{}: lattice {:.1} vs voxel {:.1} cm3 ({:+.1}%, limit {:.0}%)",
+                s.name,
+                s.lattice_volume_cm3,
+                s.voxel_volume_cm3,
+                100.0 * s.volume_error,
+                100.0 * tol
+            ));
+        }
+        if s.kind == TissueKind::Muscle {
+            let iou = s.mean_iou.unwrap_or(0.0);
+            if iou < 0.9 {
+                failures.push(format!("{}: area-weighted mean IoU {iou:.3} < 0.9", s.name));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    // Every muscle and bone of the table made it into the lattice.
+    for l in table.labels() {
+        if matches!(l.kind, TissueKind::Bone | TissueKind::Muscle) {
+            assert!(
+                report.structures.iter().any(|s| s.name == l.name),
+                "{} missing",
+                l.name
+            );
+        }
+    }
+    // The JSON report carries the documented keys.
+    let json: serde_json::Value = serde_json::from_str(&report.to_json()).unwrap();
+    let first = &json["structures"][0];
+    for key in [
+        "name",
+        "kind",
+        "voxel_volume_cm3",
+        "lattice_volume_cm3",
+        "mean_iou",
+    ] {
+        assert!(first.get(key).is_some(), "report lacks {key}");
+    }
+}
+
+#[test]
+fn visible_human_lattice_is_closed_positive_and_keeps_fat_out_of_bone() {
+    let Some((volume, table)) = common::vh_leg() else {
+        return;
+    };
+    let lattice = Lattice::build(&volume, &table, &BuildOptions::default()).unwrap();
+    let inv = lattice.check_invariants();
+    assert!(inv.is_sound(), "{inv:?}");
+    assert!(lattice.fat.hexes.len() > 10_000);
+    // The vastus intermedius wraps the femur: its polygons must not fill the bone.
+    let vi = lattice.muscle("vastus_intermedius").unwrap();
+    let femur = lattice.bone("femur").unwrap();
+    let inside = femur
+        .mesh
+        .rings
+        .iter()
+        .filter(|r| !r.cap)
+        .map(|r| femur.mesh.vertices[r.centre as usize])
+        .filter(|c| {
+            let w = myoslice::lattice::winding_number(&vi.mesh.vertices, &vi.mesh.triangles, *c);
+            w.abs() > 0.5
+        })
+        .count();
+    assert_eq!(
+        inside, 0,
+        "femur centres lie inside the vastus intermedius lattice"
+    );
+}
