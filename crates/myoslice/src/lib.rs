@@ -11,6 +11,7 @@
 //! the subject's right. Slice data arrive in mm and are converted at the edge.
 #![warn(missing_docs)]
 
+pub mod body;
 pub mod contour;
 pub mod error;
 pub mod export;
@@ -18,10 +19,13 @@ pub mod io;
 pub mod label_table;
 pub mod label_volume;
 pub mod lattice;
+pub mod muscle;
 pub mod phantom;
 pub mod report;
+pub mod simulation;
 pub mod slices;
 pub mod spatial;
+pub mod tissue;
 pub mod tracking;
 
 pub use error::{Error, Result};
@@ -29,6 +33,7 @@ pub use label_table::{Label, LabelTable, TissueKind};
 pub use label_volume::LabelVolume;
 pub use lattice::{BoneMesh, BuildOptions, FatLattice, Lattice, MuscleLattice, StructureStats};
 pub use report::BuildReport;
+pub use simulation::{Simulation, SimulationConfig};
 pub use slices::SliceReduction;
 
 /// The types most programs need.
@@ -39,5 +44,6 @@ pub mod prelude {
     pub use crate::label_volume::LabelVolume;
     pub use crate::lattice::{BuildOptions, Lattice};
     pub use crate::phantom::Phantom;
+    pub use crate::simulation::{MuscleModel, Schedule, Simulation, SimulationConfig};
     pub use crate::slices::SliceReduction;
 }

@@ -1,0 +1,570 @@
+//! The paper's muscle (section 3.2, Eq. 1): mass points in series on the muscle's centre
+//! line, joined by damped springs, pulled together by a contraction force, with end points
+//! fixed to the bones. Interior points are kept in cones anchored on the bone surface
+//! (section 4.1, Fig. 6).
+
+use glam::{Quat, Vec3};
+
+use super::wrap::{WrapCylinder, WrapPath};
+use crate::body::BodyId;
+
+/// A point fixed to a body, given in the body's rest frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Attachment {
+    /// The body.
+    pub body: BodyId,
+    /// Position at rest (body frame = world at rest).
+    pub rest: Vec3,
+}
+
+/// A cone restricting an interior chain point: apex on the bone surface (the centre of
+/// the nearest bone triangle at rest), axis through the point at rest.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ConeAnchor {
+    /// Body carrying the apex.
+    pub body: BodyId,
+    /// Apex at rest.
+    pub apex: Vec3,
+    /// Unit axis at rest.
+    pub axis: Vec3,
+}
+
+/// Body poses as seen by the chains: rotation and translation of each body.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyFrames {
+    /// Thigh pose.
+    pub thigh: (Quat, Vec3),
+    /// Shank pose.
+    pub shank: (Quat, Vec3),
+}
+
+impl BodyFrames {
+    /// Rest poses.
+    pub const REST: Self = Self {
+        thigh: (Quat::IDENTITY, Vec3::ZERO),
+        shank: (Quat::IDENTITY, Vec3::ZERO),
+    };
+
+    fn of(&self, b: BodyId) -> (Quat, Vec3) {
+        match b {
+            BodyId::Thigh => self.thigh,
+            BodyId::Shank => self.shank,
+        }
+    }
+
+    /// A rest point of body `b` in the world now.
+    pub fn point(&self, b: BodyId, p: Vec3) -> Vec3 {
+        let (q, t) = self.of(b);
+        q * p + t
+    }
+
+    /// A rest direction of body `b` in the world now.
+    pub fn vector(&self, b: BodyId, v: Vec3) -> Vec3 {
+        self.of(b).0 * v
+    }
+
+    /// Linear blend of two frames (for substeps; rotations by nlerp).
+    pub fn lerp(&self, o: &Self, t: f32) -> Self {
+        let l = |a: (Quat, Vec3), b: (Quat, Vec3)| (a.0.lerp(b.0, t).normalize(), a.1.lerp(b.1, t));
+        Self {
+            thigh: l(self.thigh, o.thigh),
+            shank: l(self.shank, o.shank),
+        }
+    }
+}
+
+/// Per-segment geometry of the current chain.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct SegmentGeom {
+    /// Length along the path (m).
+    pub length: f32,
+    /// Unit direction from its first point toward the second.
+    pub dir_a: Vec3,
+    /// Unit direction from its second point toward the first.
+    pub dir_b: Vec3,
+}
+
+/// A muscle's chain of mass points, origin (index 0) to insertion (last).
+#[derive(Debug, Clone)]
+pub struct MuscleChain {
+    /// Origin attachment.
+    pub origin: Attachment,
+    /// Insertion attachment.
+    pub insertion: Attachment,
+    /// Positions (world, m).
+    pub x: Vec<Vec3>,
+    /// Velocities (m/s).
+    pub v: Vec<Vec3>,
+    /// Mass of each interior point (kg); 0 for the end points.
+    pub mass: Vec<f32>,
+    /// Rest length of each segment (m).
+    pub rest_len: Vec<f32>,
+    /// Whether each segment is tendon (outside the muscle belly).
+    pub tendon: Vec<bool>,
+    /// Cone of each point (end points have none).
+    pub cones: Vec<Option<ConeAnchor>>,
+    /// Interior points pinned to a body (via points the tendon runs through).
+    pub vias: Vec<(usize, Attachment)>,
+    /// Cosine and tangent of the cone half-angle.
+    pub cone_cos_tan: (f32, f32),
+    /// Wrap cylinder of the segment crossing the knee, for muscles crossing it.
+    pub wrap: Option<WrapCylinder>,
+    /// Index of the segment that crosses the knee (the one that may wrap).
+    pub wrap_segment: usize,
+    /// Whether that segment is wrapped now.
+    pub wrapped: bool,
+    /// Rest length of the belly (sum of belly segments).
+    pub belly_rest: f32,
+    /// Reused buffers of the implicit step.
+    pub scratch: ChainScratch,
+    /// Geometry of every segment at the current positions (see [`Self::refresh`]).
+    pub geom: Vec<SegmentGeom>,
+}
+
+/// Work buffers of [`MuscleChain::advance`], kept to avoid allocating every step.
+#[derive(Debug, Clone, Default)]
+pub struct ChainScratch {
+    f: Vec<Vec3>,
+    kseg: Vec<f32>,
+    diag: Vec<f32>,
+    lower: Vec<f32>,
+    upper: Vec<f32>,
+    rhs: Vec<Vec3>,
+    c: Vec<f32>,
+    d: Vec<Vec3>,
+    dv: Vec<Vec3>,
+}
+
+/// Forces of one chain step on its end points (world force, world point).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EndForces {
+    /// Force on the origin body.
+    pub origin: Vec3,
+    /// Force on the insertion body.
+    pub insertion: Vec3,
+}
+
+/// How the chain's segments pull.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChainLoad {
+    /// Contraction force C along every segment (N).
+    pub contraction: f32,
+    /// Spring constant per unit segment length: k_i = stiffness / rest_i (N).
+    pub stiffness: f32,
+    /// When true (Hill mode), belly springs only spread the points: their rest lengths
+    /// follow the belly's current length, and tendons carry no spring.
+    pub neutral_springs: bool,
+    /// Gravity (m/s²).
+    pub gravity: Vec3,
+}
+
+impl MuscleChain {
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// True for an empty chain.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+
+    /// Geometry of segment `i` at the positions of the last [`Self::refresh`].
+    pub fn segment(&self, i: usize) -> SegmentGeom {
+        self.geom
+            .get(i)
+            .copied()
+            .unwrap_or_else(|| self.compute_segment(i))
+    }
+
+    /// Recomputes the cached segment geometry (after moving points).
+    pub fn refresh(&mut self) {
+        let n = self.x.len().saturating_sub(1);
+        let mut geom = std::mem::take(&mut self.geom);
+        geom.clear();
+        geom.extend((0..n).map(|i| self.compute_segment(i)));
+        self.geom = geom;
+    }
+
+    /// Geometry of segment `i` (between points i and i+1); the knee-crossing one may wrap.
+    fn compute_segment(&self, i: usize) -> SegmentGeom {
+        let (a, b) = (self.x[i], self.x[i + 1]);
+        if i == self.wrap_segment
+            && let Some(w) = &self.wrap
+        {
+            let WrapPath {
+                length,
+                dir_p,
+                dir_q,
+                ..
+            } = w.path(a, b, self.wrapped);
+            return SegmentGeom {
+                length,
+                dir_a: dir_p,
+                dir_b: dir_q,
+            };
+        }
+        let d = b - a;
+        let l = d.length().max(1e-9);
+        SegmentGeom {
+            length: l,
+            dir_a: d / l,
+            dir_b: -d / l,
+        }
+    }
+
+    /// Path length origin to insertion (m), wrapping included.
+    pub fn path_length(&self) -> f64 {
+        (0..self.x.len() - 1)
+            .map(|i| f64::from(self.segment(i).length))
+            .sum()
+    }
+
+    /// The body each point moves with: the attachment bodies at the ends, the cone's body
+    /// for interior points.
+    pub fn point_body(&self, i: usize) -> BodyId {
+        if i == 0 {
+            self.origin.body
+        } else if i + 1 == self.x.len() {
+            self.insertion.body
+        } else if let Some((_, a)) = self.vias.iter().find(|(k, _)| *k == i) {
+            a.body
+        } else {
+            self.cones[i].map_or(self.origin.body, |c| c.body)
+        }
+    }
+
+    /// Path lengthening velocity (m/s) due to the bones' motion alone: every point moving
+    /// with its body. This is the excursion the fibres see; the chain's own shape
+    /// relaxation is left out so it cannot feed back into the force-velocity relation.
+    pub fn anchored_path_velocity(&self, velocity_of: impl Fn(BodyId, Vec3) -> Vec3) -> f64 {
+        (0..self.x.len() - 1)
+            .map(|i| {
+                let g = self.segment(i);
+                let va = velocity_of(self.point_body(i), self.x[i]);
+                let vb = velocity_of(self.point_body(i + 1), self.x[i + 1]);
+                -f64::from(va.dot(g.dir_a) + vb.dot(g.dir_b))
+            })
+            .sum()
+    }
+
+    /// Current belly length (m).
+    pub fn belly_length(&self) -> f32 {
+        (0..self.x.len() - 1)
+            .filter(|&i| !self.tendon[i])
+            .map(|i| self.segment(i).length)
+            .sum()
+    }
+
+    /// Updates whether the knee-crossing segment is wrapped (call after points move).
+    pub fn update_wrap(&mut self) {
+        if let Some(w) = &self.wrap {
+            let i = self.wrap_segment;
+            self.wrapped = w.path(self.x[i], self.x[i + 1], self.wrapped).wrapped;
+        }
+        self.refresh();
+    }
+
+    /// Moves the end points onto their attachments.
+    pub fn attach_ends(&mut self, frames: &BodyFrames) {
+        let n = self.x.len();
+        self.x[0] = frames.point(self.origin.body, self.origin.rest);
+        self.x[n - 1] = frames.point(self.insertion.body, self.insertion.rest);
+        for (i, a) in &self.vias {
+            self.x[*i] = frames.point(a.body, a.rest);
+        }
+    }
+
+    fn tension(
+        &self,
+        i: usize,
+        g: &SegmentGeom,
+        load: &ChainLoad,
+        belly_scale: f32,
+        damping: f32,
+    ) -> f32 {
+        let rate = -(self.v[i].dot(g.dir_a) + self.v[i + 1].dot(g.dir_b));
+        let k = load.stiffness / self.rest_len[i].max(5e-3);
+        let spring = if load.neutral_springs {
+            if self.tendon[i] {
+                0.0
+            } else {
+                k * (g.length - self.rest_len[i] * belly_scale)
+            }
+        } else {
+            k * (g.length - self.rest_len[i])
+        };
+        spring + damping * rate + load.contraction
+    }
+
+    /// Whether every point of the chain moves with one body (no knee crossing, no cone on
+    /// the other body): then an unloaded chain is carried rigidly.
+    pub fn single_body(&self) -> Option<BodyId> {
+        let b = self.origin.body;
+        (0..self.x.len())
+            .all(|i| self.point_body(i) == b)
+            .then_some(b)
+    }
+
+    /// Carries the whole chain rigidly with body `b` from `from` to `to`.
+    pub fn carry(&mut self, b: BodyId, from: &BodyFrames, to: &BodyFrames, dt: f32) {
+        let (q0, t0) = match b {
+            BodyId::Thigh => from.thigh,
+            BodyId::Shank => from.shank,
+        };
+        let (q1, t1) = match b {
+            BodyId::Thigh => to.thigh,
+            BodyId::Shank => to.shank,
+        };
+        if q0 == q1 && t0 == t1 {
+            self.v.iter_mut().for_each(|v| *v = Vec3::ZERO);
+            return;
+        }
+        let inv = q0.inverse();
+        for i in 0..self.x.len() {
+            let rest = inv * (self.x[i] - t0);
+            let p = to.point(b, rest);
+            self.v[i] = (p - self.x[i]) / dt;
+            self.x[i] = p;
+        }
+        self.refresh();
+    }
+
+    /// Advances the interior points by `dt` while the bodies move from `from` to `to`:
+    /// Eq. 1 with gravity, integrated by linearly implicit (backward) Euler so that stiff
+    /// springs and large contraction forces stay stable at the 1 kHz step, then the cone
+    /// projection. Returns the number of substeps taken.
+    pub fn advance(
+        &mut self,
+        dt: f32,
+        from: &BodyFrames,
+        to: &BodyFrames,
+        load: &ChainLoad,
+    ) -> usize {
+        let n = self.x.len();
+        if n < 3 {
+            self.attach_ends(to);
+            return 0;
+        }
+        // Backward Euler is stable at any step; two substeps keep the linearisation
+        // accurate when the chain swings fast.
+        let subs = 1;
+        let h = dt / subs as f32;
+        let m_min = self.mass[1..n - 1]
+            .iter()
+            .copied()
+            .filter(|&m| m > 0.0)
+            .fold(f32::INFINITY, f32::min)
+            .max(1e-6);
+        let l_min = self
+            .rest_len
+            .iter()
+            .copied()
+            .fold(f32::INFINITY, f32::min)
+            .max(5e-3);
+        let k_max = load.stiffness / l_min + load.contraction.abs() / l_min;
+        // Critical damping of the stiffest mode of the lightest point.
+        let damping = (k_max * m_min).sqrt();
+        let mut sc = std::mem::take(&mut self.scratch);
+        sc.f.resize(n, Vec3::ZERO);
+        sc.kseg.resize(n, 0.0);
+        for s in 0..subs {
+            let (f, kseg) = (&mut sc.f, &mut sc.kseg);
+            let fr = from.lerp(to, (s + 1) as f32 / subs as f32);
+            let old_ends = (self.x[0], self.x[n - 1]);
+            let old_vias: Vec<Vec3> = self.vias.iter().map(|(i, _)| self.x[*i]).collect();
+            self.attach_ends(&fr);
+            self.v[0] = (self.x[0] - old_ends.0) / h;
+            self.v[n - 1] = (self.x[n - 1] - old_ends.1) / h;
+            for ((i, _), o) in self.vias.iter().zip(&old_vias) {
+                self.v[*i] = (self.x[*i] - *o) / h;
+            }
+            self.refresh();
+            let belly_scale = if load.neutral_springs {
+                self.belly_length() / self.belly_rest.max(1e-6)
+            } else {
+                1.0
+            };
+            f.iter_mut().for_each(|v| *v = Vec3::ZERO);
+            for i in 0..n - 1 {
+                let g = self.segment(i);
+                let t = self.tension(i, &g, load, belly_scale, damping);
+                f[i] += g.dir_a * t;
+                f[i + 1] += g.dir_b * t;
+                // Stiffness of the segment: axial spring plus the transverse stiffness of
+                // a string under tension (never negative, for stability).
+                let u = g.dir_a;
+                let k_ax = if load.neutral_springs && self.tendon[i] {
+                    0.0
+                } else {
+                    load.stiffness / self.rest_len[i].max(5e-3)
+                };
+                let t_l = (t.max(0.0)) / g.length.max(1e-4);
+                // Isotropic bound of the segment stiffness: a scalar tridiagonal system,
+                // slightly over-damping the softer direction, stable for any step.
+                let _ = u;
+                kseg[i] = k_ax.max(t_l);
+            }
+            for i in 1..n - 1 {
+                if self.mass[i] > 0.0 {
+                    f[i] += load.gravity * self.mass[i];
+                }
+            }
+            self.solve_implicit(h, damping, &mut sc);
+            for i in 1..n - 1 {
+                if self.mass[i] <= 0.0 {
+                    continue; // pinned via point
+                }
+                let old = self.x[i];
+                self.v[i] += sc.dv[i];
+                self.x[i] += self.v[i] * h;
+                if let Some(c) = self.cones[i] {
+                    let apex = fr.point(c.body, c.apex);
+                    let axis = fr.vector(c.body, c.axis);
+                    self.x[i] = project_into_cone(self.x[i], apex, axis, self.cone_cos_tan);
+                    // Position-based correction: the velocity follows the projected motion.
+                    self.v[i] = (self.x[i] - old) / h;
+                }
+            }
+            self.update_wrap();
+        }
+        self.scratch = sc;
+        subs
+    }
+
+    /// Solves `(M + h·D + h²·K) Δv = h (f + h·K·v)` over the interior points, with the
+    /// isotropic segment stiffness (scalar tridiagonal; pinned points have Δv = 0), into
+    /// `sc.dv`.
+    fn solve_implicit(&self, h: f32, damping: f32, sc: &mut ChainScratch) {
+        let n = self.x.len();
+        for v in [&mut sc.diag, &mut sc.lower, &mut sc.upper, &mut sc.c] {
+            v.clear();
+            v.resize(n, 0.0);
+        }
+        for v in [&mut sc.rhs, &mut sc.d, &mut sc.dv] {
+            v.clear();
+            v.resize(n, Vec3::ZERO);
+        }
+        let (f, kseg) = (&sc.f, &sc.kseg);
+        sc.diag.iter_mut().for_each(|d| *d = 1.0);
+        let dmp = h * damping;
+        for i in 1..n - 1 {
+            let m = self.mass[i];
+            if m <= 0.0 {
+                continue;
+            }
+            let (kl, kr) = (kseg[i - 1], kseg[i]);
+            sc.diag[i] = m + 2.0 * dmp + (kl + kr) * h * h;
+            let pinned = |j: usize| j == 0 || j == n - 1 || self.mass[j] <= 0.0;
+            if !pinned(i - 1) {
+                sc.lower[i] = -dmp - kl * h * h;
+            }
+            if !pinned(i + 1) {
+                sc.upper[i] = -dmp - kr * h * h;
+            }
+            let kv = (self.v[i - 1] - self.v[i]) * kl + (self.v[i + 1] - self.v[i]) * kr;
+            sc.rhs[i] = (f[i] + kv * h) * h;
+        }
+        // Thomas algorithm.
+        for i in 1..n - 1 {
+            let inv = 1.0 / (sc.diag[i] - sc.lower[i] * sc.c[i - 1]);
+            sc.c[i] = inv * sc.upper[i];
+            sc.d[i] = (sc.rhs[i] - sc.d[i - 1] * sc.lower[i]) * inv;
+        }
+        for i in (1..n - 1).rev() {
+            let v = sc.d[i] - sc.dv[i + 1] * sc.c[i];
+            sc.dv[i] = if v.is_finite() { v } else { Vec3::ZERO };
+        }
+    }
+
+    /// Lets the chain settle at rest under a steady contraction force `tension` (N),
+    /// with the bones still, then takes the settled shape as its rest shape. A muscle's
+    /// centre line from the slices is not in equilibrium under tension; settling first
+    /// keeps that straightening out of the simulated fibre length.
+    pub fn settle(&mut self, frames: &BodyFrames, tension: f32, stiffness: f32, gravity: Vec3) {
+        let load = ChainLoad {
+            contraction: tension,
+            stiffness,
+            neutral_springs: true,
+            gravity,
+        };
+        for _ in 0..200 {
+            self.advance(1e-3, frames, frames, &load);
+            for v in &mut self.v {
+                *v *= 0.5;
+            }
+        }
+        self.v.iter_mut().for_each(|v| *v = Vec3::ZERO);
+        for i in 0..self.x.len() - 1 {
+            self.rest_len[i] = self.segment(i).length.max(1e-4);
+        }
+        self.belly_rest = (0..self.x.len() - 1)
+            .filter(|&i| !self.tendon[i])
+            .map(|i| self.rest_len[i])
+            .sum();
+    }
+
+    /// Forces the chain puts on its two bodies for the given loading. In Hill mode the
+    /// bones feel the tendon force `hill_force` along the end segments; in the paper's
+    /// mode they feel the full Eq. 1 segment force.
+    pub fn end_forces(&self, load: &ChainLoad, hill_force: Option<f32>) -> EndForces {
+        let n = self.x.len();
+        let (g0, g1) = (self.segment(0), self.segment(n - 2));
+        match hill_force {
+            Some(t) => EndForces {
+                origin: g0.dir_a * t,
+                insertion: g1.dir_b * t,
+            },
+            None => {
+                let t0 = self.tension(0, &g0, load, 1.0, 0.0);
+                let t1 = self.tension(n - 2, &g1, load, 1.0, 0.0);
+                EndForces {
+                    origin: g0.dir_a * t0,
+                    insertion: g1.dir_b * t1,
+                }
+            }
+        }
+    }
+}
+
+/// Closest point of the cone (apex, unit axis, half-angle given by its cosine and
+/// tangent) to `p`.
+pub fn project_into_cone(p: Vec3, apex: Vec3, axis: Vec3, (cos_a, tan_a): (f32, f32)) -> Vec3 {
+    let w = p - apex;
+    let t = w.dot(axis);
+    let radial = w - axis * t;
+    let r = radial.length();
+    if t > 0.0 && r <= t * tan_a {
+        return p;
+    }
+    let sin_a = cos_a * tan_a;
+    let s = t * cos_a + r * sin_a;
+    if s <= 0.0 {
+        return apex;
+    }
+    let rhat = if r > 1e-12 {
+        radial / r
+    } else {
+        axis.any_orthonormal_vector()
+    };
+    apex + (axis * cos_a + rhat * sin_a) * s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cone_projection_keeps_inside_points_and_lands_outside_ones_on_the_surface() {
+        let cs = (30f32.to_radians().cos(), 30f32.to_radians().tan());
+        let inside = Vec3::new(0.1, 0.0, 1.0);
+        assert_eq!(project_into_cone(inside, Vec3::ZERO, Vec3::Z, cs), inside);
+        let q = project_into_cone(Vec3::new(2.0, 0.0, 1.0), Vec3::ZERO, Vec3::Z, cs);
+        let ang = (q.x / q.z).atan().to_degrees();
+        assert!((ang - 30.0).abs() < 1e-3, "{ang}");
+        assert_eq!(
+            project_into_cone(Vec3::new(0.0, 0.0, -1.0), Vec3::ZERO, Vec3::Z, cs),
+            Vec3::ZERO
+        );
+    }
+}

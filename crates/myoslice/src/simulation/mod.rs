@@ -1,0 +1,630 @@
+//! The one `Simulation` API every front uses: build from a lattice, step, excite muscles,
+//! read the knee and the muscles.
+
+mod config;
+mod schedule;
+
+use std::sync::Arc;
+
+use glam::Vec3;
+
+pub use config::{MuscleModel, SimulationConfig};
+pub use schedule::Schedule;
+
+use crate::body::{BodyId, Skeleton, SkeletonOptions, knee_axis};
+use crate::error::{Error, Result, check_positive, check_range};
+use crate::lattice::{BuildOptions, Lattice};
+use crate::muscle::hill::activation_rate;
+use crate::muscle::{
+    BodyFrames, ChainLoad, ChainOptions, MuscleCatalogue, MuscleGroup, MuscleUnit,
+};
+use crate::tissue::{Tissue, TissueMetrics, bone_surfaces};
+
+/// What a muscle reports.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MuscleReadout {
+    /// Name.
+    pub name: String,
+    /// Control group.
+    pub group: MuscleGroup,
+    /// Excitation in [0, 1].
+    pub excitation: f64,
+    /// Activation in [0, 1].
+    pub activation: f64,
+    /// Tendon force (N).
+    pub force: f64,
+    /// Fibre length (m).
+    pub fibre_length: f64,
+    /// Fibre length over optimal fibre length.
+    pub normalised_fibre_length: f64,
+    /// Moment arm about the knee (m), positive for flexion; 0 when it does not cross it.
+    pub moment_arm: f64,
+    /// Path length origin to insertion (m).
+    pub path_length: f64,
+}
+
+/// The dynamic state of a simulation, for checkpoints (`state` / `set_state`).
+#[derive(Debug, Clone)]
+pub struct SimulationState {
+    time: f64,
+    steps: u64,
+    skeleton: Skeleton,
+    muscles: Vec<MuscleUnit>,
+    frames: BodyFrames,
+    knee_torque: f64,
+    tissue: Option<Tissue>,
+}
+
+impl SimulationState {
+    /// Simulated time of the checkpoint (s).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+}
+
+/// A muscle-driven lower limb.
+#[derive(Debug, Clone)]
+pub struct Simulation {
+    lattice: Arc<Lattice>,
+    config: SimulationConfig,
+    skeleton: Skeleton,
+    muscles: Vec<MuscleUnit>,
+    schedules: Vec<Option<Schedule>>,
+    time: f64,
+    steps: u64,
+    frames: BodyFrames,
+    knee_torque: f64,
+    tissue: Option<Tissue>,
+}
+
+impl Simulation {
+    /// Builds a simulation of a lattice body.
+    ///
+    /// ```no_run
+    /// use myoslice::prelude::*;
+    /// let mut sim = Simulation::phantom(SimulationConfig::default())?;
+    /// sim.set_excitation("semitendinosus", 1.0)?;
+    /// sim.step(0.5)?;
+    /// println!("knee at {:.1} deg", sim.knee_angle().to_degrees());
+    /// # Ok::<(), myoslice::Error>(())
+    /// ```
+    pub fn new(
+        lattice: Lattice,
+        config: SimulationConfig,
+        catalogue: &MuscleCatalogue,
+    ) -> Result<Self> {
+        config.validate()?;
+        let femur = lattice.bone("femur").ok_or_else(|| {
+            Error::Build("the lattice has no 'femur' bone: the knee needs one".into())
+        })?;
+        let knee = knee_axis(femur)?;
+        let skeleton = Skeleton::new(
+            &lattice,
+            knee,
+            &SkeletonOptions {
+                body_mass: config.body_mass_kg,
+                height: config.height_m,
+                limits: config.knee_limits_deg.map(f64::to_radians),
+                damping: config.knee_damping,
+                gravity: config.gravity,
+            },
+        )?;
+        let meshes: Vec<_> = (0..lattice.bones.len())
+            .map(|i| {
+                skeleton
+                    .bone_trimesh(i)
+                    .ok_or_else(|| Error::Build("bone collider missing".into()))
+            })
+            .collect::<Result<_>>()?;
+        let opts = ChainOptions {
+            spacing: config.chain_spacing_m,
+            cone_half_angle: config.cone_half_angle_deg.to_radians(),
+            stiffness: config.chain_stiffness as f32,
+            gravity: Vec3::from_array(config.gravity.map(|g| g as f32)),
+        };
+        let muscles = (0..lattice.muscles.len())
+            .map(|i| MuscleUnit::build(&lattice, i, &meshes, &knee, catalogue, &opts))
+            .collect::<Result<Vec<_>>>()?;
+        let tissue = if config.tissue.enabled {
+            let bones = bone_surfaces(&lattice, &meshes);
+            Some(Tissue::new(
+                &lattice,
+                &muscles,
+                knee,
+                bones,
+                config.tissue.clone(),
+            )?)
+        } else {
+            None
+        };
+        let n = muscles.len();
+        let mut sim = Self {
+            lattice: Arc::new(lattice),
+            config,
+            skeleton,
+            muscles,
+            schedules: vec![None; n],
+            time: 0.0,
+            steps: 0,
+            frames: BodyFrames::REST,
+            knee_torque: 0.0,
+            tissue,
+        };
+        if sim.config.initial_knee_deg != 0.0 {
+            sim.set_knee(sim.config.initial_knee_deg.to_radians(), 0.0)?;
+        }
+        Ok(sim)
+    }
+
+    /// The built-in phantom with the default lattice options and muscle catalogue.
+    pub fn phantom(config: SimulationConfig) -> Result<Self> {
+        let (volume, table) = crate::phantom::Phantom::default().generate()?;
+        let lattice = Lattice::build(&volume, &table, &BuildOptions::default())?;
+        Self::new(lattice, config, &MuscleCatalogue::default())
+    }
+
+    /// A NIfTI label volume and its label table.
+    pub fn from_nifti(
+        volume: impl AsRef<std::path::Path>,
+        labels: impl AsRef<std::path::Path>,
+        build: &BuildOptions,
+        config: SimulationConfig,
+    ) -> Result<Self> {
+        let v = crate::io::read_nifti(volume)?;
+        let t = crate::label_table::LabelTable::from_path(labels)?;
+        let lattice = Lattice::build(&v, &t, build)?;
+        Self::new(lattice, config, &MuscleCatalogue::default())
+    }
+
+    /// The lattice body.
+    pub fn lattice(&self) -> &Lattice {
+        &self.lattice
+    }
+
+    /// The lattice, shared.
+    pub fn lattice_arc(&self) -> Arc<Lattice> {
+        Arc::clone(&self.lattice)
+    }
+
+    /// The options.
+    pub fn config(&self) -> &SimulationConfig {
+        &self.config
+    }
+
+    /// The rigid skeleton.
+    pub fn skeleton(&self) -> &Skeleton {
+        &self.skeleton
+    }
+
+    /// Body poses now.
+    pub fn frames(&self) -> &BodyFrames {
+        &self.frames
+    }
+
+    /// The deformable tissue (None when disabled).
+    pub fn tissue(&self) -> Option<&Tissue> {
+        self.tissue.as_ref()
+    }
+
+    /// Tissue metrics of the last tissue update (None when tissue is disabled).
+    pub fn tissue_metrics(&self) -> Option<&TissueMetrics> {
+        self.tissue.as_ref().map(|t| &t.metrics)
+    }
+
+    /// Updates the tissue now for the current pose (also done automatically at
+    /// `tissue.rate_hz` while stepping).
+    pub fn update_tissue(&mut self) -> Result<()> {
+        let angle = self.knee_angle();
+        if let Some(t) = &mut self.tissue
+            && !t.update(&self.lattice, angle, &self.frames, &self.muscles)
+        {
+            return Err(Error::NonFinite {
+                time: self.time,
+                what: "tissue".into(),
+            });
+        }
+        Ok(())
+    }
+
+    /// The muscle-tendon units, in lattice order.
+    pub fn muscles(&self) -> &[MuscleUnit] {
+        &self.muscles
+    }
+
+    /// Muscle names, in order.
+    pub fn muscle_names(&self) -> Vec<&str> {
+        self.muscles.iter().map(|m| m.name.as_str()).collect()
+    }
+
+    /// Index of a muscle by name.
+    pub fn muscle_index(&self, name: &str) -> Result<usize> {
+        self.muscles
+            .iter()
+            .position(|m| m.name == name)
+            .ok_or_else(|| {
+                Error::unknown_name("muscle", name, self.muscles.iter().map(|m| m.name.as_str()))
+            })
+    }
+
+    /// Simulated time (s).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Knee flexion angle (rad).
+    pub fn knee_angle(&self) -> f64 {
+        self.skeleton.knee_angle()
+    }
+
+    /// Knee flexion velocity (rad/s).
+    pub fn knee_velocity(&self) -> f64 {
+        self.skeleton.knee_velocity()
+    }
+
+    /// Net muscle torque about the knee in the last step (N m), positive flexing.
+    pub fn knee_torque(&self) -> f64 {
+        self.knee_torque
+    }
+
+    /// Sets one muscle's excitation (and drops its schedule).
+    pub fn set_excitation(&mut self, name: &str, value: f64) -> Result<()> {
+        let i = self.muscle_index(name)?;
+        check_range(&format!("excitation of {name}"), value, 0.0, 1.0)?;
+        self.muscles[i].excitation = value;
+        self.schedules[i] = None;
+        Ok(())
+    }
+
+    /// Sets every muscle's excitation, in muscle order.
+    pub fn set_excitations(&mut self, values: &[f64]) -> Result<()> {
+        if values.len() != self.muscles.len() {
+            return Err(Error::invalid(
+                "excitations",
+                format!("{} values", values.len()),
+                format!("expected one per muscle ({})", self.muscles.len()),
+            ));
+        }
+        for (i, v) in values.iter().enumerate() {
+            check_range(
+                &format!("excitation of {}", self.muscles[i].name),
+                *v,
+                0.0,
+                1.0,
+            )?;
+        }
+        for (i, v) in values.iter().enumerate() {
+            self.muscles[i].excitation = *v;
+            self.schedules[i] = None;
+        }
+        Ok(())
+    }
+
+    /// Excitations in muscle order.
+    pub fn excitations(&self) -> Vec<f64> {
+        self.muscles.iter().map(|m| m.excitation).collect()
+    }
+
+    /// Drives a muscle's excitation by a schedule of absolute simulation time.
+    pub fn set_schedule(&mut self, name: &str, schedule: Schedule) -> Result<()> {
+        let i = self.muscle_index(name)?;
+        self.muscles[i].excitation = schedule.value(self.time);
+        self.schedules[i] = Some(schedule);
+        Ok(())
+    }
+
+    /// What one muscle reports.
+    pub fn muscle(&self, name: &str) -> Result<MuscleReadout> {
+        Ok(self.readout(self.muscle_index(name)?))
+    }
+
+    /// What muscle `i` reports.
+    pub fn readout(&self, i: usize) -> MuscleReadout {
+        let m = &self.muscles[i];
+        MuscleReadout {
+            name: m.name.clone(),
+            group: m.group,
+            excitation: m.excitation,
+            activation: m.activation,
+            force: m.force,
+            fibre_length: m.fibre.length,
+            normalised_fibre_length: m.fibre.length / m.hill.optimal_fibre_length,
+            moment_arm: m.moment_arm,
+            path_length: m.path_length,
+        }
+    }
+
+    /// Puts the knee at `angle` (rad) and `velocity` (rad/s), moving the muscle chains
+    /// with the shank.
+    pub fn set_knee(&mut self, angle: f64, velocity: f64) -> Result<()> {
+        let [lo, hi] = self.skeleton.limits();
+        check_range("knee angle (rad)", angle, lo, hi)?;
+        check_range("knee velocity (rad/s)", velocity, -100.0, 100.0)?;
+        let before = self.frames;
+        // Sweep the wrapped tendons through the intermediate angles so each ends up on
+        // the side continuous motion would have put it.
+        let start = self.knee_angle();
+        let steps = ((angle - start).abs() / 1f64.to_radians()).ceil().max(1.0) as usize;
+        let knee = *self.skeleton.knee();
+        for k in 1..=steps {
+            let a = start + (angle - start) * k as f64 / steps as f64;
+            let q = glam::Quat::from_axis_angle(knee.axis, a as f32);
+            let shank = (q, knee.point - q * knee.point);
+            let frames = BodyFrames {
+                thigh: before.thigh,
+                shank,
+            };
+            for m in &mut self.muscles {
+                let Some(w) = m.chain.wrap else { continue };
+                let i = m.chain.wrap_segment;
+                let place = |j: usize, chain: &crate::muscle::MuscleChain| -> Vec3 {
+                    let b = chain.point_body(j);
+                    let rest = match b {
+                        BodyId::Shank => before.shank.0.inverse() * (chain.x[j] - before.shank.1),
+                        BodyId::Thigh => before.thigh.0.inverse() * (chain.x[j] - before.thigh.1),
+                    };
+                    frames.point(b, rest)
+                };
+                let (p, q) = (place(i, &m.chain), place(i + 1, &m.chain));
+                m.chain.wrapped = w.path(p, q, m.chain.wrapped).wrapped;
+            }
+        }
+        self.skeleton.set_knee(angle, velocity);
+        self.frames = self.current_frames();
+        for m in &mut self.muscles {
+            // Points anchored on the shank follow it; the rest stay.
+            let n = m.chain.len();
+            for i in 0..n {
+                if let Some(c) = m.chain.cones[i]
+                    && c.body == BodyId::Shank
+                {
+                    let rest = before.shank.0.inverse() * (m.chain.x[i] - before.shank.1);
+                    m.chain.x[i] = self.frames.point(BodyId::Shank, rest);
+                }
+                m.chain.v[i] = Vec3::ZERO;
+            }
+            m.chain.attach_ends(&self.frames);
+            m.chain.update_wrap();
+            m.path_length = m.chain.path_length();
+            m.path_velocity = 0.0;
+        }
+        if self.tissue.is_some() {
+            // The fat follows a jump in a few relaxation passes.
+            for _ in 0..4 {
+                self.update_tissue()?;
+            }
+        }
+        Ok(())
+    }
+
+    fn current_frames(&self) -> BodyFrames {
+        let t = self.skeleton.pose(BodyId::Thigh);
+        let s = self.skeleton.pose(BodyId::Shank);
+        BodyFrames {
+            thigh: (t.rotation, t.translation),
+            shank: (s.rotation, s.translation),
+        }
+    }
+
+    /// Advances the simulation by `dt` seconds (split into steps of at most
+    /// `max_step_s`). If anything becomes non-finite, the state before the call is kept
+    /// and an error says what failed.
+    pub fn step(&mut self, dt: f64) -> Result<()> {
+        check_positive("dt", dt)?;
+        if dt > 10.0 {
+            return Err(Error::invalid("dt", dt, "expected at most 10 s per call"));
+        }
+        let n = (dt / self.config.max_step_s).ceil().max(1.0) as usize;
+        let h = dt / n as f64;
+        // The tissue keeps its own last good shape; the rest is cheap to keep here.
+        let saved = (
+            self.time,
+            self.steps,
+            self.skeleton.clone(),
+            self.muscles.clone(),
+            self.frames,
+            self.knee_torque,
+        );
+        let restore = |sim: &mut Self, what: String| {
+            let t = sim.time;
+            (
+                sim.time,
+                sim.steps,
+                sim.skeleton,
+                sim.muscles,
+                sim.frames,
+                sim.knee_torque,
+            ) = saved.clone();
+            Err(Error::NonFinite { time: t, what })
+        };
+        for _ in 0..n {
+            self.substep(h);
+            if let Some(what) = self.non_finite() {
+                return restore(self, what);
+            }
+            let due = self.tissue.as_mut().is_some_and(|t| t.advance_clock(h));
+            if due && self.update_tissue().is_err() {
+                return restore(self, "fat or muscle shape".into());
+            }
+        }
+        Ok(())
+    }
+
+    fn non_finite(&self) -> Option<String> {
+        if !self.knee_angle().is_finite() || !self.knee_velocity().is_finite() {
+            return Some("knee angle".into());
+        }
+        for m in &self.muscles {
+            if !m.force.is_finite() || m.chain.x.iter().any(|p| !p.is_finite()) {
+                return Some(format!("muscle {}", m.name));
+            }
+        }
+        None
+    }
+
+    fn substep(&mut self, h: f64) {
+        let gravity = self.skeleton.gravity();
+        let knee = *self.skeleton.knee();
+        let hill = self.config.muscle_model == MuscleModel::Hill;
+        let mut forces = Vec::with_capacity(2 * self.muscles.len());
+        let mut torque = 0.0;
+        let frames = self.frames;
+        let knee_point = frames.point(BodyId::Thigh, knee.point);
+        let knee_dir = frames.vector(BodyId::Thigh, knee.axis);
+        let mut loads = Vec::with_capacity(self.muscles.len());
+        for (m, sched) in self.muscles.iter_mut().zip(&self.schedules) {
+            if let Some(s) = sched {
+                m.excitation = s.value(self.time);
+            }
+            let load = ChainLoad {
+                contraction: 0.0,
+                stiffness: (self.config.chain_stiffness * m.hill.max_isometric_force) as f32,
+                neutral_springs: hill,
+                gravity,
+            };
+            let quiet = !m.crosses_knee
+                && m.excitation == 0.0
+                && m.activation < 1e-4
+                && m.force < 1e-3 * m.hill.max_isometric_force;
+            if quiet && m.chain.single_body().is_some() {
+                // At rest on one body: no force to compute or apply.
+                m.force = 0.0;
+                m.moment_arm = 0.0;
+                loads.push(load);
+                continue;
+            }
+            let (tension, ends) = if hill {
+                m.fibre = m
+                    .hill
+                    .rigid_tendon_kinematics(m.path_length, m.path_velocity);
+                let f = m.hill.force(m.activation, &m.fibre);
+                m.force = f.tendon;
+                let load = ChainLoad {
+                    contraction: f.tendon as f32,
+                    ..load
+                };
+                (
+                    f.tendon as f32,
+                    m.chain.end_forces(&load, Some(f.tendon as f32)),
+                )
+            } else {
+                m.activation = m.excitation;
+                let c = (m.excitation * m.hill.max_isometric_force) as f32;
+                let load = ChainLoad {
+                    contraction: c,
+                    ..load
+                };
+                let e = m.chain.end_forces(&load, None);
+                m.force = f64::from(e.insertion.length());
+                m.fibre = m
+                    .hill
+                    .rigid_tendon_kinematics(m.path_length, m.path_velocity);
+                (c, e)
+            };
+            loads.push(ChainLoad {
+                contraction: tension,
+                ..load
+            });
+            let n = m.chain.len();
+            let ins = m.chain.x[n - 1];
+            let org = m.chain.x[0];
+            let mut tau = 0.0;
+            if m.chain.insertion.body == BodyId::Shank {
+                forces.push((ends.insertion, ins));
+                tau += f64::from((ins - knee_point).cross(ends.insertion).dot(knee_dir));
+            }
+            if m.chain.origin.body == BodyId::Shank {
+                forces.push((ends.origin, org));
+                tau += f64::from((org - knee_point).cross(ends.origin).dot(knee_dir));
+            }
+            let f = f64::from(ends.insertion.length().max(ends.origin.length()));
+            m.moment_arm = if m.crosses_knee {
+                let dir = m.chain.segment(n - 2).dir_b;
+                let sgn = if m.chain.insertion.body == BodyId::Shank {
+                    1.0
+                } else {
+                    -1.0
+                };
+                sgn * f64::from((ins - knee_point).cross(dir).dot(knee_dir))
+            } else {
+                0.0
+            };
+            let _ = f;
+            torque += tau;
+        }
+        self.knee_torque = torque;
+        self.skeleton.step(h, &forces);
+        let next = self.current_frames();
+        let (shank_v, shank_w, shank_c) = self.skeleton.shank_motion();
+        for (m, load) in self.muscles.iter_mut().zip(&loads) {
+            // A muscle at rest on one body is carried with it; only loaded or
+            // knee-crossing chains need their dynamics.
+            let quiet = m.excitation == 0.0
+                && m.activation < 1e-4
+                && m.force < 1e-3 * m.hill.max_isometric_force;
+            match m.chain.single_body() {
+                Some(b) if quiet => m.chain.carry(b, &frames, &next, h as f32),
+                _ => {
+                    m.chain.advance(h as f32, &frames, &next, load);
+                }
+            }
+            if hill {
+                let rate = activation_rate(
+                    m.excitation,
+                    m.activation,
+                    m.hill.tau_activation,
+                    m.hill.tau_deactivation,
+                    10.0,
+                );
+                m.activation = (m.activation + h * rate).clamp(0.0, 1.0);
+            }
+            m.path_length = m.chain.path_length();
+            m.path_velocity = if m.crosses_knee {
+                m.chain.anchored_path_velocity(|b, p| match b {
+                    BodyId::Thigh => Vec3::ZERO,
+                    BodyId::Shank => shank_v + shank_w.cross(p - shank_c),
+                })
+            } else {
+                // Both ends and every cone on one rigid body: no excursion.
+                0.0
+            };
+        }
+        self.frames = next;
+        self.time += h;
+        self.steps += 1;
+    }
+
+    /// A checkpoint of everything that changes while stepping.
+    pub fn state(&self) -> SimulationState {
+        SimulationState {
+            time: self.time,
+            steps: self.steps,
+            skeleton: self.skeleton.clone(),
+            muscles: self.muscles.clone(),
+            frames: self.frames,
+            knee_torque: self.knee_torque,
+            tissue: self.tissue.clone(),
+        }
+    }
+
+    /// Restores a checkpoint taken from this simulation.
+    pub fn set_state(&mut self, s: &SimulationState) -> Result<()> {
+        if s.muscles.len() != self.muscles.len()
+            || s.muscles
+                .iter()
+                .zip(&self.muscles)
+                .any(|(a, b)| a.name != b.name || a.chain.len() != b.chain.len())
+        {
+            return Err(Error::StateMismatch(
+                "the checkpoint has other muscles".into(),
+            ));
+        }
+        self.time = s.time;
+        self.steps = s.steps;
+        self.skeleton = s.skeleton.clone();
+        self.muscles = s.muscles.clone();
+        self.frames = s.frames;
+        self.knee_torque = s.knee_torque;
+        self.tissue.clone_from(&s.tissue);
+        Ok(())
+    }
+}

@@ -1,0 +1,229 @@
+//! Muscle shape at constant volume (paper, section 4.1, Fig. 7): every cross-section ring
+//! rides on its muscle's chain at a fixed place, turns with the chain, and is scaled by
+//! `sqrt(L0/L)` across and `L/L0` along when its chain segment goes from `L0` to `L`, so
+//! the local volume (and the muscle's) is kept.
+
+use glam::{Quat, Vec3};
+
+use crate::lattice::{MuscleLattice, signed_volume};
+
+/// The smooth rotation field about the knee that tissue near the joint follows: a point at
+/// rest height `z` turns by `w(z)·θ` about the axis, `w` rising smoothly from 0 above the
+/// knee band to 1 below it.
+#[derive(Debug, Clone, Copy)]
+pub struct KneeField {
+    /// Axis point (rest).
+    pub point: Vec3,
+    /// Unit flexion axis.
+    pub axis: Vec3,
+    /// Knee angle (rad).
+    pub theta: f32,
+    /// Half-width of the band (m).
+    pub band: f32,
+}
+
+/// Contact behind the knee: the plane through the knee axis that bisects the knee angle.
+/// Tissue of the thigh keeps to its side, tissue of the calf to the other, so the back
+/// of the thigh and the calf press on each other there and never pass through.
+#[derive(Debug, Clone, Copy)]
+pub struct Contact {
+    /// Knee axis point (world).
+    pub point: Vec3,
+    /// Unit normal of the plane, toward the thigh.
+    pub normal: Vec3,
+    /// Distance (m) muscles keep from the plane.
+    pub muscle_margin: f32,
+}
+
+impl Contact {
+    /// The contact at knee angle `theta` (rad): the thigh's superior direction `up`
+    /// turned by half the angle about the flexion `axis`.
+    pub fn new(point: Vec3, axis: Vec3, up: Vec3, theta: f32, muscle_margin: f32) -> Self {
+        Self {
+            point,
+            normal: Quat::from_axis_angle(axis, 0.5 * theta) * up,
+            muscle_margin,
+        }
+    }
+
+    /// Where `p` goes; `thigh` says which side it belongs to, `margin` (m) how far from
+    /// the plane it stays.
+    pub fn apply(&self, p: Vec3, thigh: bool, margin: f32) -> Vec3 {
+        let s = if thigh { 1.0 } else { -1.0 };
+        let d = (p - self.point).dot(self.normal) * s;
+        if d < margin {
+            p + self.normal * (s * (margin - d))
+        } else {
+            p
+        }
+    }
+}
+
+impl KneeField {
+    /// Share of the shank's rotation at rest position `p`.
+    pub fn weight(&self, p: Vec3) -> f32 {
+        let t = ((self.point.z + self.band - p.z) / (2.0 * self.band)).clamp(0.0, 1.0);
+        t * t * (3.0 - 2.0 * t)
+    }
+
+    /// The field's rotation at rest position `p`.
+    pub fn rotation(&self, p: Vec3) -> Quat {
+        Quat::from_axis_angle(self.axis, self.theta * self.weight(p))
+    }
+
+    /// How much the field rules at `p`: 1 at the axis height, 0 beyond the band.
+    pub fn nearness(&self, p: Vec3) -> f32 {
+        (1.0 - (p.z - self.point.z).abs() / self.band).clamp(0.0, 1.0)
+    }
+}
+use crate::muscle::MuscleChain;
+
+/// Where a ring rides on the chain and how its vertices sit around it.
+#[derive(Debug, Clone)]
+pub struct MuscleShape {
+    /// Chain positions at rest.
+    rest_chain: Vec<Vec3>,
+    /// Segment and fraction along it of each ring's centre.
+    ring_param: Vec<(u32, f32)>,
+    /// Ring index of each vertex.
+    ring_of: Vec<u32>,
+    /// Axial offset and perpendicular offset of each vertex in its segment's rest frame.
+    axial: Vec<f32>,
+    perp: Vec<Vec3>,
+    /// Current vertex positions (world, m).
+    pub current: Vec<Vec3>,
+    /// Rest vertex positions.
+    pub rest: Vec<Vec3>,
+    /// Enclosed volume at rest (m³).
+    pub rest_volume: f64,
+    /// Surface triangles (from the lattice).
+    pub triangles: Vec<[u32; 3]>,
+}
+
+fn closest_on_polyline(p: &[Vec3], q: Vec3) -> (u32, f32) {
+    let mut best = (0u32, 0.0f32, f32::INFINITY);
+    for i in 0..p.len().saturating_sub(1) {
+        let (a, b) = (p[i], p[i + 1]);
+        let ab = b - a;
+        let t = ((q - a).dot(ab) / ab.length_squared().max(1e-12)).clamp(0.0, 1.0);
+        let d = (a + ab * t).distance_squared(q);
+        if d < best.2 {
+            best = (i as u32, t, d);
+        }
+    }
+    (best.0, best.1)
+}
+
+impl MuscleShape {
+    /// Binds a muscle lattice to its chain at rest.
+    pub fn new(lattice: &MuscleLattice, chain: &MuscleChain) -> Self {
+        let rest_chain = chain.x.clone();
+        let mesh = &lattice.mesh;
+        let n = mesh.ring_len() as u32;
+        let mut ring_of = vec![0u32; mesh.vertices.len()];
+        let mut ring_param = Vec::with_capacity(mesh.rings.len());
+        for (ri, r) in mesh.rings.iter().enumerate() {
+            for v in r.first..r.first + n {
+                ring_of[v as usize] = ri as u32;
+            }
+            ring_of[r.centre as usize] = ri as u32;
+            ring_param.push(closest_on_polyline(
+                &rest_chain,
+                mesh.vertices[r.centre as usize],
+            ));
+        }
+        let mut axial = Vec::with_capacity(mesh.vertices.len());
+        let mut perp = Vec::with_capacity(mesh.vertices.len());
+        for (vi, &v) in mesh.vertices.iter().enumerate() {
+            let (s, t) = ring_param[ring_of[vi] as usize];
+            let (a, b) = (rest_chain[s as usize], rest_chain[s as usize + 1]);
+            let u0 = (b - a).normalize_or(Vec3::Z);
+            let o = v - a.lerp(b, t);
+            let ax = o.dot(u0);
+            axial.push(ax);
+            perp.push(o - u0 * ax);
+        }
+        Self {
+            rest_chain,
+            ring_param,
+            ring_of,
+            axial,
+            perp,
+            current: mesh.vertices.clone(),
+            rest: mesh.vertices.clone(),
+            rest_volume: mesh.volume().abs(),
+            triangles: mesh.triangles.clone(),
+        }
+    }
+
+    /// Places every vertex on the chain's current shape. Near the knee (within `band` m
+    /// of its axis) the rings turn with the same smooth field as the fat, a share
+    /// `w(z)` of the knee angle about the axis, instead of with the chain's bend: rings
+    /// on two sides of a sharp bend would otherwise cross.
+    ///
+    /// `contact` keeps thigh-side and calf-side vertices apart behind the knee (see
+    /// [`Contact`]); the cross-sections then make up the volume it squeezed out.
+    pub fn update(&mut self, chain: &MuscleChain, knee: &KneeField, contact: Option<&Contact>) {
+        let segs = self.rest_chain.len() - 1;
+        let mut seg_rot = Vec::with_capacity(segs);
+        let mut seg_len = Vec::with_capacity(segs);
+        for s in 0..segs {
+            let (a0, b0) = (self.rest_chain[s], self.rest_chain[s + 1]);
+            let (a, b) = (chain.x[s], chain.x[s + 1]);
+            let (d0, d) = (b0 - a0, b - a);
+            let (l0, l) = (d0.length().max(1e-6), d.length().max(1e-6));
+            seg_rot.push(Quat::from_rotation_arc(d0 / l0, d / l));
+            seg_len.push((l / l0, d0 / l0));
+        }
+        // Rotation and stretch at each chain point: the mean of its two segments.
+        let point = |i: usize| -> (Quat, f32) {
+            let a = i.saturating_sub(1).min(segs - 1);
+            let b = i.min(segs - 1);
+            (
+                seg_rot[a].slerp(seg_rot[b], 0.5),
+                0.5 * (seg_len[a].0 + seg_len[b].0),
+            )
+        };
+        let mut across_fix = 1.0f32;
+        for pass in 0..3 {
+            for (vi, p) in self.current.iter_mut().enumerate() {
+                let ring = self.ring_of[vi] as usize;
+                let (s, t) = self.ring_param[ring];
+                let s = s as usize;
+                let ((q0, l0), (q1, l1)) = (point(s), point(s + 1));
+                let mut q = q0.slerp(q1, t);
+                let lambda = l0 + (l1 - l0) * t;
+                let centre_rest = self.rest_chain[s].lerp(self.rest_chain[s + 1], t);
+                let near = knee.nearness(centre_rest);
+                if near > 0.0 {
+                    q = q.slerp(knee.rotation(centre_rest), near);
+                }
+                let u0 = seg_len[s].1;
+                let c = chain.x[s].lerp(chain.x[s + 1], t);
+                let across = across_fix / lambda.sqrt();
+                *p = c + q * (u0 * (self.axial[vi] * lambda) + self.perp[vi] * across);
+            }
+            if let Some(c) = contact {
+                for (p, r) in self.current.iter_mut().zip(&self.rest) {
+                    *p = c.apply(*p, r.z >= knee.point.z, c.muscle_margin);
+                }
+            }
+            if pass < 2 {
+                // What the piecewise map still gains or loses, the cross-sections give
+                // back: one factor per muscle, the square root of the volume ratio.
+                let v = self.volume();
+                if v > 0.0 {
+                    across_fix *= ((self.rest_volume / v) as f32).sqrt();
+                }
+                if (across_fix - 1.0).abs() < 1e-4 {
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Enclosed volume now (m³).
+    pub fn volume(&self) -> f64 {
+        signed_volume(&self.current, &self.triangles).abs()
+    }
+}

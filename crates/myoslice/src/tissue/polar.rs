@@ -1,0 +1,60 @@
+//! Rotation extraction for shape matching: the rotation of the polar decomposition of a
+//! 3×3 matrix, by Müller et al. (2016), "A robust method to extract the rotational part of
+//! deformations", warm-started from the previous rotation. Branch-free in the inner loop.
+
+use glam::{Mat3, Quat, Vec3};
+
+/// Improves `q` toward the rotation of the polar decomposition of `a` (columns `a0..a2`)
+/// with `iters` iterations; returns the new unit quaternion.
+#[inline]
+pub fn extract_rotation(a: &Mat3, mut q: Quat, iters: usize) -> Quat {
+    for _ in 0..iters {
+        let r = Mat3::from_quat(q);
+        let num = r.x_axis.cross(a.x_axis) + r.y_axis.cross(a.y_axis) + r.z_axis.cross(a.z_axis);
+        let den =
+            (r.x_axis.dot(a.x_axis) + r.y_axis.dot(a.y_axis) + r.z_axis.dot(a.z_axis)).abs() + 1e-9;
+        let omega = num / den;
+        let w = omega.length();
+        if w < 1e-9 {
+            break;
+        }
+        q = (Quat::from_axis_angle(omega / w, w) * q).normalize();
+    }
+    q
+}
+
+/// The rotation of `a` from scratch (identity start, enough iterations to converge).
+pub fn polar_rotation(a: &Mat3) -> Quat {
+    extract_rotation(a, Quat::IDENTITY, 64)
+}
+
+/// `Σ p_i r_iᵀ` for current relative positions `p` and rest relative positions `r`.
+#[inline]
+pub fn covariance(p: &[Vec3], r: &[Vec3]) -> Mat3 {
+    let mut c0 = Vec3::ZERO;
+    let mut c1 = Vec3::ZERO;
+    let mut c2 = Vec3::ZERO;
+    for (pi, ri) in p.iter().zip(r) {
+        c0 += *pi * ri.x;
+        c1 += *pi * ri.y;
+        c2 += *pi * ri.z;
+    }
+    Mat3::from_cols(c0, c1, c2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_rotation_of_a_rotated_stretch_is_recovered() {
+        let rot = Quat::from_axis_angle(Vec3::new(1.0, 2.0, 3.0).normalize(), 1.3);
+        let stretch = Mat3::from_diagonal(Vec3::new(1.4, 0.7, 1.1));
+        let a = Mat3::from_quat(rot) * stretch;
+        let q = polar_rotation(&a);
+        assert!(q.angle_between(rot) < 1e-4, "{}", q.angle_between(rot));
+        // Warm start from nearby converges in a couple of iterations.
+        let q2 = extract_rotation(&a, rot * Quat::from_rotation_z(0.1), 3);
+        assert!(q2.angle_between(rot) < 1e-3);
+    }
+}
