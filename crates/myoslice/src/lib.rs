@@ -22,6 +22,7 @@ pub mod lattice;
 pub mod muscle;
 pub mod phantom;
 pub mod report;
+pub mod scenario;
 pub mod simulation;
 pub mod slices;
 pub mod spatial;
@@ -44,6 +45,7 @@ pub mod prelude {
     pub use crate::label_volume::LabelVolume;
     pub use crate::lattice::{BuildOptions, Lattice};
     pub use crate::phantom::Phantom;
+    pub use crate::scenario::Scenario;
     pub use crate::simulation::{MuscleModel, Schedule, Simulation, SimulationConfig};
     pub use crate::slices::SliceReduction;
 }

@@ -160,8 +160,7 @@ impl Skeleton {
         multibody
             .insert(thigh, shank, joint, true)
             .ok_or_else(|| Error::Build("rapier refused the knee joint".into()))?;
-        let mut params = IntegrationParameters::default();
-        params.dt = 1e-3;
+        let params = IntegrationParameters { dt: 1e-3, ..IntegrationParameters::default() };
         let mut sk = Self {
             bodies,
             colliders,
@@ -330,29 +329,17 @@ impl Skeleton {
     }
 
     /// Kinetic + gravitational potential energy of the shank (J), zero potential at rest.
+    /// On the hinge the kinetic energy is `½ I_knee θ̇²` with the inertia about the axis.
     pub fn shank_energy(&self) -> f64 {
-        let Some(b) = self.bodies.get(self.shank) else {
-            return 0.0;
-        };
-        let v = b.linvel().as_dvec3();
-        let w = b.angvel().as_dvec3();
+        let pose = self.pose(BodyId::Shank);
+        let com = pose.transform_point(self.com);
+        let r = self.com - self.knee.point;
+        let d2 = f64::from((r - self.knee.axis * r.dot(self.knee.axis)).length_squared());
         let m = self.inertia.mass;
-        // Inertia tensor in world frame.
-        let r = b.rotation();
-        let dir = (r * Quat::from_rotation_arc(Vec3::Z, (self.com - self.knee.point).normalize()))
-            * Vec3::Z;
-        let d = dir.as_dvec3();
-        let wl = w.dot(d);
-        let wt = w - d * wl;
-        let ke = 0.5 * m * v.length_squared()
-            + 0.5 * self.inertia.inertia_transverse * wt.length_squared()
-            + 0.5 * self.inertia.inertia_long * wl * wl;
-        let pe = -m
-            * self
-                .gravity
-                .as_dvec3()
-                .dot((b.center_of_mass() - self.com).as_dvec3());
-        ke + pe
+        let i_knee = self.inertia.inertia_transverse + m * d2;
+        let w = self.knee_velocity();
+        let pe = -m * self.gravity.as_dvec3().dot((com - self.com).as_dvec3());
+        0.5 * i_knee * w * w + pe
     }
 
     /// The collider of each lattice bone, with its body (lattice bone order).

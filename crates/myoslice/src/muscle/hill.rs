@@ -180,8 +180,8 @@ mod tests {
         assert!(passive_force_length(0.9).abs() < 0.01);
         assert!((passive_force_length(1.6) - 1.0).abs() < 1e-9);
         assert!((force_velocity(0.0) - 1.0).abs() < 0.01);
-        assert!(force_velocity(-1.0).abs() < 0.01);
+        assert!(force_velocity(-1.0).abs() < 0.02);
         assert!((force_velocity_inverse(force_velocity(0.37)) - 0.37).abs() < 1e-9);
-        assert!(tendon_force_length(1.0).abs() < 0.01);
+        assert!(tendon_force_length(1.0).abs() < 0.02);
     }
 }

@@ -37,7 +37,7 @@ impl WrapCylinder {
         (e1, a.cross(e1))
     }
 
-    fn to_2d(&self, p: Vec3) -> (DVec2, f32) {
+    fn planar(&self, p: Vec3) -> (DVec2, f32) {
         let (e1, e2) = self.basis();
         let d = p - self.point;
         (
@@ -46,7 +46,7 @@ impl WrapCylinder {
         )
     }
 
-    fn from_2d(&self, q: DVec2, h: f32) -> Vec3 {
+    fn spatial(&self, q: DVec2, h: f32) -> Vec3 {
         let (e1, e2) = self.basis();
         self.point + e1 * q.x as f32 + e2 * q.y as f32 + self.axis * h
     }
@@ -59,15 +59,15 @@ impl WrapCylinder {
             radius: 0.0,
             side: 1.0,
         };
-        let (a, _) = c.to_2d(p);
-        let (b, _) = c.to_2d(q);
+        let (a, _) = c.planar(p);
+        let (b, _) = c.planar(q);
         if a.perp_dot(b) >= 0.0 { 1.0 } else { -1.0 }
     }
 
     /// Signed distance (m) of the straight line p→q from the axis, positive on `side`.
     pub fn clearance(&self, p: Vec3, q: Vec3) -> f32 {
-        let (a, _) = self.to_2d(p);
-        let (b, _) = self.to_2d(q);
+        let (a, _) = self.planar(p);
+        let (b, _) = self.planar(q);
         let len = (b - a).length().max(1e-12);
         (f64::from(self.side) * a.perp_dot(b) / len) as f32
     }
@@ -87,8 +87,8 @@ impl WrapCylinder {
                 wrapped: false,
             }
         };
-        let (a, ha) = self.to_2d(p);
-        let (b, hb) = self.to_2d(q);
+        let (a, ha) = self.planar(p);
+        let (b, hb) = self.planar(q);
         let r = f64::from(self.radius);
         let (da, db) = (a.length(), b.length());
         if r <= 0.0 || da <= r * 1.0001 || db <= r * 1.0001 {
@@ -119,7 +119,7 @@ impl WrapCylinder {
         // Along the axis the path climbs linearly with its length.
         let h1 = ha + (hb - ha) * (l1 / total) as f32;
         let h2 = ha + (hb - ha) * ((l1 + l2) / total) as f32;
-        let (p1, p2) = (self.from_2d(t1, h1), self.from_2d(t2, h2));
+        let (p1, p2) = (self.spatial(t1, h1), self.spatial(t2, h2));
         let planar = l1 + l2 + l3;
         let length = (planar * planar + f64::from(hb - ha).powi(2)).sqrt() as f32;
         WrapPath {

@@ -3,7 +3,7 @@
 use glam::{Mat3, Vec3};
 
 use super::Tissue;
-use super::polar::{covariance, extract_rotation};
+use super::polar::{covariance, polar_rotation_exact};
 use crate::lattice::{Lattice, hex_volume_points, quad_area};
 
 /// Metrics of the tissue at one moment; arrays are contiguous, one value per fat
@@ -48,7 +48,7 @@ impl TissueMetrics {
             let c = p.iter().copied().sum::<Vec3>() / 8.0;
             let d = p.map(|q| q - c);
             let r = fat.rest_relative(e);
-            let q = extract_rotation(&covariance(&d, r), fat.rot[e], 6);
+            let q = polar_rotation_exact(&covariance(&d, r), fat.rot[e]);
             let m = Mat3::from_quat(q);
             degree[e] = (0..8).map(|k| (m * r[k] - d[k]).length()).sum::<f32>() / 8.0;
         }

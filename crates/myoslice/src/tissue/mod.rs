@@ -254,7 +254,18 @@ impl Tissue {
         // Muscles are not pushed by the contact plane: their volume is the invariant
         // kept; the fat over them is.
         for (shape, m) in self.muscles.iter_mut().zip(muscles) {
-            shape.update(&m.chain, &field, None);
+            // A muscle resting on one body keeps its rest shape and moves with the body.
+            let quiet = !m.crosses_knee && m.activation < 1e-4 && m.excitation == 0.0;
+            match m.chain.single_body() {
+                Some(b) if quiet => {
+                    let (q, t) = match b {
+                        BodyId::Thigh => frames.thigh,
+                        BodyId::Shank => frames.shank,
+                    };
+                    shape.carry(q, t);
+                }
+                _ => shape.update(&m.chain, &field, None),
+            }
         }
         // First guess, from the rest shape (so nothing accumulates): every vertex turns
         // about the knee by its share of the shank's rotation; each radial column of

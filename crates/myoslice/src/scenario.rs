@@ -1,0 +1,439 @@
+//! Scenario files: an experiment as a TOML file that can be kept and shared.
+//!
+//! ```toml
+//! [model]
+//! source = "phantom"          # or "nifti", with volume = "...", labels = "..." (relative
+//!                             # to this file)
+//! slice_step = 5              # keep every k-th slice (default 5)
+//! rays = 48                   # rays per polygon (default 48)
+//!
+//! [body]
+//! mass_kg = 60.0              # default 60
+//! height_m = 1.65             # default 1.65
+//!
+//! [simulation]
+//! muscle_model = "hill"       # or "spring" (the paper's), default hill
+//! duration_s = 1.0            # required
+//! step_s = 0.001              # default 0.001
+//! initial_knee_deg = 0.0      # default 0
+//!
+//! [tissue]                    # every TissueConfig field, all optional
+//! rate_hz = 30.0
+//!
+//! [excitation]                # per muscle or group: [[time s, value], ...]
+//! hamstrings = [[0.0, 0.0], [0.2, 0.6]]
+//!
+//! [output]
+//! frames = 30                 # output frames over the run (default 25)
+//! vtu = true                  # ParaView series (default true)
+//! glb = true                  # animated glTF for Blender (default true)
+//! ```
+//!
+//! Groups: `flexors`, `extensors`, `hamstrings`, `quadriceps`, `all`.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::error::{Error, Result};
+use crate::lattice::BuildOptions;
+use crate::muscle::MuscleGroup;
+use crate::simulation::{MuscleModel, Schedule, Simulation, SimulationConfig};
+use crate::slices::SliceReduction;
+use crate::tissue::TissueConfig;
+
+/// Where the model comes from.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSection {
+    /// `phantom` or `nifti`.
+    #[serde(default = "default_source")]
+    pub source: String,
+    /// NIfTI volume (for `nifti`), relative to the scenario file.
+    pub volume: Option<PathBuf>,
+    /// Label table (for `nifti`).
+    pub labels: Option<PathBuf>,
+    /// Keep every k-th slice.
+    #[serde(default = "default_step")]
+    pub slice_step: usize,
+    /// Rays per polygon.
+    #[serde(default = "default_rays")]
+    pub rays: usize,
+}
+
+fn default_source() -> String {
+    "phantom".into()
+}
+fn default_step() -> usize {
+    5
+}
+fn default_rays() -> usize {
+    48
+}
+
+impl Default for ModelSection {
+    fn default() -> Self {
+        Self {
+            source: default_source(),
+            volume: None,
+            labels: None,
+            slice_step: 5,
+            rays: 48,
+        }
+    }
+}
+
+/// Body size.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BodySection {
+    /// Body mass (kg).
+    pub mass_kg: f64,
+    /// Body height (m).
+    pub height_m: f64,
+}
+
+impl Default for BodySection {
+    fn default() -> Self {
+        Self {
+            mass_kg: 60.0,
+            height_m: 1.65,
+        }
+    }
+}
+
+/// Run settings.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimulationSection {
+    /// Muscle model.
+    #[serde(default = "default_model")]
+    pub muscle_model: MuscleModel,
+    /// Simulated time (s).
+    pub duration_s: f64,
+    /// Step (s).
+    #[serde(default = "default_dt")]
+    pub step_s: f64,
+    /// Knee angle at the start (deg).
+    #[serde(default)]
+    pub initial_knee_deg: f64,
+}
+
+fn default_model() -> MuscleModel {
+    MuscleModel::Hill
+}
+fn default_dt() -> f64 {
+    1e-3
+}
+
+/// What to write.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct OutputSection {
+    /// Frames written over the run (besides the first).
+    pub frames: usize,
+    /// Write VTU frames and a PVD series.
+    pub vtu: bool,
+    /// Write an animated GLB.
+    pub glb: bool,
+}
+
+impl Default for OutputSection {
+    fn default() -> Self {
+        Self {
+            frames: 25,
+            vtu: true,
+            glb: true,
+        }
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawScenario {
+    #[serde(default)]
+    model: ModelSection,
+    #[serde(default)]
+    body: BodySection,
+    simulation: SimulationSection,
+    #[serde(default)]
+    tissue: TissueConfig,
+    #[serde(default)]
+    excitation: BTreeMap<String, Vec<(f64, f64)>>,
+    #[serde(default)]
+    output: OutputSection,
+}
+
+/// A parsed scenario.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scenario {
+    /// File it came from (for relative paths and messages).
+    pub path: PathBuf,
+    /// Model.
+    pub model: ModelSection,
+    /// Body.
+    pub body: BodySection,
+    /// Run.
+    pub simulation: SimulationSection,
+    /// Tissue options.
+    pub tissue: TissueConfig,
+    /// Excitation schedules by muscle or group name.
+    pub excitation: BTreeMap<String, Schedule>,
+    /// Outputs.
+    pub output: OutputSection,
+    text: String,
+}
+
+impl Scenario {
+    /// Reads and checks a scenario file.
+    pub fn from_path(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        Self::from_str_at(&text, path)
+    }
+
+    /// Parses scenario text; `path` locates relative files and names errors.
+    pub fn from_str_at(text: &str, path: &Path) -> Result<Self> {
+        let err = |reason: String| Error::Parse {
+            path: path.into(),
+            reason,
+        };
+        let raw: RawScenario = toml::from_str(text).map_err(|e| err(e.to_string()))?;
+        let line_of = |key: &str| {
+            text.lines()
+                .position(|l| l.trim_start().starts_with(key))
+                .map_or(String::new(), |n| format!(" (line {})", n + 1))
+        };
+        let s = &raw.simulation;
+        if !(s.duration_s.is_finite() && s.duration_s > 0.0) {
+            return Err(err(format!(
+                "simulation.duration_s = {}{}: expected a duration > 0 s",
+                s.duration_s,
+                line_of("duration_s")
+            )));
+        }
+        if !(s.step_s.is_finite() && s.step_s > 0.0 && s.step_s <= 0.01) {
+            return Err(err(format!(
+                "simulation.step_s = {}{}: expected 0 < step <= 0.01 s",
+                s.step_s,
+                line_of("step_s")
+            )));
+        }
+        match raw.model.source.as_str() {
+            "phantom" => {}
+            "nifti" => {
+                for (k, v) in [
+                    ("model.volume", &raw.model.volume),
+                    ("model.labels", &raw.model.labels),
+                ] {
+                    let Some(p) = v else {
+                        return Err(err(format!(
+                            "{k} is required when model.source = \"nifti\""
+                        )));
+                    };
+                    let full = resolve(path, p);
+                    if !full.exists() {
+                        return Err(err(format!(
+                            "{k} = {}{}: file not found ({})",
+                            p.display(),
+                            line_of(k.trim_start_matches("model.")),
+                            full.display()
+                        )));
+                    }
+                }
+            }
+            other => {
+                return Err(err(format!(
+                    "model.source = \"{other}\"{}: expected \"phantom\" or \"nifti\"",
+                    line_of("source")
+                )));
+            }
+        }
+        let mut excitation = BTreeMap::new();
+        for (name, pts) in raw.excitation {
+            let sched = Schedule::new(pts)
+                .map_err(|e| err(format!("excitation.{name}{}: {e}", line_of(&name))))?;
+            excitation.insert(name, sched);
+        }
+        Ok(Self {
+            path: path.into(),
+            model: raw.model,
+            body: raw.body,
+            simulation: raw.simulation,
+            tissue: raw.tissue,
+            excitation,
+            output: raw.output,
+            text: text.to_string(),
+        })
+    }
+
+    /// The simulation configuration it describes.
+    pub fn config(&self) -> SimulationConfig {
+        SimulationConfig {
+            body_mass_kg: self.body.mass_kg,
+            height_m: self.body.height_m,
+            muscle_model: self.simulation.muscle_model,
+            initial_knee_deg: self.simulation.initial_knee_deg,
+            max_step_s: self.simulation.step_s,
+            tissue: self.tissue.clone(),
+            ..SimulationConfig::default()
+        }
+    }
+
+    /// The lattice options it describes.
+    pub fn build_options(&self) -> BuildOptions {
+        BuildOptions {
+            reduction: SliceReduction {
+                slice_step: self.model.slice_step,
+                pixel_mm: None,
+            },
+            rays: self.model.rays,
+            ..BuildOptions::default()
+        }
+    }
+
+    /// Builds the simulation with its schedules applied.
+    pub fn build(&self) -> Result<Simulation> {
+        let err = |reason: String| Error::Parse {
+            path: self.path.clone(),
+            reason,
+        };
+        let config = self.config();
+        config.validate().map_err(|e| err(e.to_string()))?;
+        let mut sim = match self.model.source.as_str() {
+            "nifti" => {
+                let v = resolve(
+                    &self.path,
+                    self.model.volume.as_deref().unwrap_or(Path::new("")),
+                );
+                let l = resolve(
+                    &self.path,
+                    self.model.labels.as_deref().unwrap_or(Path::new("")),
+                );
+                Simulation::from_nifti(v, l, &self.build_options(), config)?
+            }
+            _ => {
+                let (volume, table) = crate::phantom::Phantom::default().generate()?;
+                let lattice =
+                    crate::lattice::Lattice::build(&volume, &table, &self.build_options())?;
+                Simulation::new(lattice, config, &crate::muscle::MuscleCatalogue::default())?
+            }
+        };
+        self.apply_schedules(&mut sim)?;
+        Ok(sim)
+    }
+
+    /// Applies the excitation schedules to a simulation (checking every name).
+    pub fn apply_schedules(&self, sim: &mut Simulation) -> Result<()> {
+        for (name, sched) in &self.excitation {
+            let targets = group_members(sim, name);
+            if targets.is_empty() {
+                let known: Vec<&str> = sim.muscle_names();
+                let e = Error::unknown_name(
+                    "muscle or group",
+                    name,
+                    known.into_iter().chain(GROUPS.iter().copied()),
+                );
+                let line = self
+                    .text
+                    .lines()
+                    .position(|l| l.trim_start().starts_with(name.as_str()))
+                    .map_or(String::new(), |n| format!(" (line {})", n + 1));
+                return Err(Error::Parse {
+                    path: self.path.clone(),
+                    reason: format!("excitation.{name}{line}: {e}"),
+                });
+            }
+            for m in targets {
+                sim.set_schedule(&m, sched.clone())?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Group names scenarios accept.
+pub const GROUPS: [&str; 5] = ["flexors", "extensors", "hamstrings", "quadriceps", "all"];
+
+/// Muscles a name stands for: itself, or the members of a group.
+pub fn group_members(sim: &Simulation, name: &str) -> Vec<String> {
+    const HAMSTRINGS: [&str; 4] = [
+        "semitendinosus",
+        "semimembranosus",
+        "biceps_femoris_long",
+        "biceps_femoris_short",
+    ];
+    const QUADRICEPS: [&str; 4] = [
+        "rectus_femoris",
+        "vastus_lateralis",
+        "vastus_medialis",
+        "vastus_intermedius",
+    ];
+    let all = sim.muscles();
+    let pick = |f: &dyn Fn(&crate::muscle::MuscleUnit) -> bool| {
+        all.iter()
+            .filter(|m| f(m))
+            .map(|m| m.name.clone())
+            .collect()
+    };
+    match name {
+        "flexors" => pick(&|m| m.group == MuscleGroup::Flexor),
+        "extensors" => pick(&|m| m.group == MuscleGroup::Extensor),
+        "hamstrings" => pick(&|m| HAMSTRINGS.contains(&m.name.as_str())),
+        "quadriceps" => pick(&|m| QUADRICEPS.contains(&m.name.as_str())),
+        "all" => pick(&|_| true),
+        n => pick(&|m| m.name == n),
+    }
+}
+
+fn resolve(scenario: &Path, p: &Path) -> PathBuf {
+    if p.is_absolute() {
+        p.to_path_buf()
+    } else {
+        scenario.parent().unwrap_or(Path::new(".")).join(p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(t: &str) -> Result<Scenario> {
+        Scenario::from_str_at(t, Path::new("test.toml"))
+    }
+
+    #[test]
+    fn a_minimal_scenario_parses_with_defaults() {
+        let s = parse(
+            "[simulation]\nduration_s = 0.5\n[excitation]\nhamstrings = [[0.0, 0.0], [0.1, 0.5]]\n",
+        )
+        .unwrap();
+        assert_eq!(s.model.source, "phantom");
+        assert_eq!(s.simulation.step_s, 1e-3);
+        assert_eq!(s.output.frames, 25);
+        assert!((s.excitation["hamstrings"].value(0.05) - 0.25).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_scenarios_name_the_problem() {
+        let e = parse("[simulation]\nduration_s = 0.5\nbogus = 1\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("bogus") && e.contains("line 3"), "{e}");
+        let e = parse("[simulation]\nduration_s = \"long\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("duration_s"), "{e}");
+        let e = parse("[simulation]\nduration_s = -1\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("duration_s") && e.contains("line 2"), "{e}");
+        let e = parse("[model]\nsource = \"nifti\"\nvolume = \"nope.nii\"\nlabels = \"nope.json\"\n[simulation]\nduration_s = 1\n").unwrap_err().to_string();
+        assert!(e.contains("model.volume") && e.contains("not found"), "{e}");
+        let e = parse("[simulation]\nduration_s = 1\n[excitation]\nx = [[0.0, 2.0]]\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("excitation.x"), "{e}");
+    }
+}

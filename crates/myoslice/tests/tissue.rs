@@ -1,0 +1,235 @@
+//! Tissue deformation: constant-volume muscles, shape-matching fat and the metrics.
+
+#![allow(clippy::unwrap_used)] // tests fail loudly by design
+
+mod common;
+
+use glam::{Quat, Vec3};
+use myoslice::muscle::MuscleCatalogue;
+use myoslice::prelude::*;
+use myoslice::tissue::intersect::self_intersections;
+use myoslice::tissue::{Tissue, TissueMetrics, bone_surfaces};
+
+fn phantom_lattice() -> Lattice {
+    let (v, t) = Phantom::default().generate().unwrap();
+    Lattice::build(&v, &t, &BuildOptions::default()).unwrap()
+}
+
+/// A fresh tissue of a simulation (its own copy, to move by hand).
+fn tissue_of(sim: &Simulation) -> Tissue {
+    let lat = sim.lattice();
+    let meshes: Vec<_> = (0..lat.bones.len())
+        .map(|i| sim.skeleton().bone_trimesh(i).unwrap())
+        .collect();
+    Tissue::new(
+        lat,
+        sim.muscles(),
+        *sim.skeleton().knee(),
+        bone_surfaces(lat, &meshes),
+        Default::default(),
+    )
+    .unwrap()
+}
+
+#[test]
+fn rigid_motions_leave_no_deformation_and_no_area_change() {
+    let sim = Simulation::new(
+        phantom_lattice(),
+        SimulationConfig::default(),
+        &MuscleCatalogue::default(),
+    )
+    .unwrap();
+    let mut t = tissue_of(&sim);
+    let q = Quat::from_axis_angle(Vec3::new(0.2, 1.0, 0.4).normalize(), 0.9);
+    let shift = Vec3::new(0.3, -0.1, 0.25);
+    for (x, r) in t.fat.x.iter_mut().zip(&t.fat.rest) {
+        *x = q * *r + shift;
+    }
+    let m = TissueMetrics::measure(sim.lattice(), &t);
+    let worst_degree = m.deformation_degree.iter().copied().fold(0.0f32, f32::max);
+    let worst_area = m.area_change.iter().map(|a| a.abs()).fold(0.0f32, f32::max);
+    assert!(
+        worst_degree < 1e-5,
+        "deformation degree {worst_degree} m after a rigid motion"
+    );
+    assert!(
+        worst_area < 1e-4,
+        "area change {worst_area} after a rigid motion"
+    );
+    assert!((m.min_volume_ratio - 1.0).abs() < 1e-3);
+}
+
+#[test]
+fn stretched_skin_shows_positive_area_change_and_compressed_skin_negative() {
+    let sim = Simulation::new(
+        phantom_lattice(),
+        SimulationConfig::default(),
+        &MuscleCatalogue::default(),
+    )
+    .unwrap();
+    let lat = sim.lattice();
+    let fat = &lat.fat;
+    let mut t = tissue_of(&sim);
+    // Around slice 40 the skin is pushed out (stretched); around slice 120, drawn in.
+    for (band, factor) in [(38..43, 1.25f32), (118..123, 0.8f32)] {
+        for s in band {
+            let c = fat.reference[s];
+            for j in 0..fat.rays {
+                for l in 1..=fat.layers {
+                    let v = fat.vertex_index(s, j, l) as usize;
+                    let d = t.fat.rest[v] - c;
+                    let radial = Vec3::new(d.x, d.y, 0.0);
+                    t.fat.x[v] =
+                        t.fat.rest[v] + radial * (factor - 1.0) * (l as f32 / fat.layers as f32);
+                }
+            }
+        }
+    }
+    let m = TissueMetrics::measure(lat, &t);
+    let outer = |s: usize, j: usize| m.area_change[fat.hex_index(s, j, fat.layers - 1) as usize];
+    let grown = (0..fat.rays).filter(|&j| outer(40, j) > 0.05).count();
+    let shrunk = (0..fat.rays).filter(|&j| outer(120, j) < -0.05).count();
+    assert!(
+        grown > fat.rays * 9 / 10,
+        "{grown} of {} stretched faces grew",
+        fat.rays
+    );
+    assert!(
+        shrunk > fat.rays * 9 / 10,
+        "{shrunk} of {} compressed faces shrank",
+        fat.rays
+    );
+    assert!(outer(80, 0).abs() < 1e-5, "untouched skin keeps its area");
+}
+
+/// Drives a flexion to deep flexion with the hamstrings, then back with the quadriceps,
+/// and calls `check` on every tissue update.
+fn flex_and_back(sim: &mut Simulation, speed: f64, mut check: impl FnMut(&Simulation)) -> f64 {
+    let flex = [
+        "semitendinosus",
+        "semimembranosus",
+        "biceps_femoris_long",
+        "biceps_femoris_short",
+        "gracilis",
+        "sartorius",
+    ];
+    let ext = [
+        "rectus_femoris",
+        "vastus_lateralis",
+        "vastus_medialis",
+        "vastus_intermedius",
+    ];
+    let mut max_angle = 0.0f64;
+    let period = sim.tissue().unwrap().period();
+    let steps = (1.6 / speed / period).ceil() as usize;
+    for k in 0..steps {
+        let t = k as f64 * period * speed;
+        for m in flex {
+            sim.set_excitation(m, if t < 0.8 { 1.0 } else { 0.0 })
+                .unwrap();
+        }
+        for m in ext {
+            sim.set_excitation(m, if t < 0.8 { 0.0 } else { (0.6 * speed).min(1.0) })
+                .unwrap();
+        }
+        sim.step(period).unwrap();
+        max_angle = max_angle.max(sim.knee_angle());
+        check(sim);
+    }
+    max_angle
+}
+
+fn muscle_volumes_stay_within_one_percent(lattice: Lattice) {
+    let mut sim = Simulation::new(
+        lattice,
+        SimulationConfig::default(),
+        &MuscleCatalogue::default(),
+    )
+    .unwrap();
+    let (mut lo, mut hi) = (1.0f32, 1.0f32);
+    let max = flex_and_back(&mut sim, 1.0, |s| {
+        for r in &s.tissue_metrics().unwrap().muscle_volume_ratio {
+            lo = lo.min(*r);
+            hi = hi.max(*r);
+        }
+    });
+    assert!(
+        max.to_degrees() > 125.0,
+        "the flexion reached only {:.1}°",
+        max.to_degrees()
+    );
+    assert!(
+        lo > 0.99 && hi < 1.01,
+        "muscle volume ratio range [{lo:.4}, {hi:.4}]"
+    );
+}
+
+#[test]
+fn muscle_volume_is_conserved_through_a_deep_flexion_of_the_phantom() {
+    muscle_volumes_stay_within_one_percent(phantom_lattice());
+}
+
+#[test]
+fn muscle_volume_is_conserved_through_a_deep_flexion_of_the_visible_human_leg() {
+    let Some((v, t)) = common::vh_leg() else {
+        return;
+    };
+    muscle_volumes_stay_within_one_percent(
+        Lattice::build(&v, &t, &BuildOptions::default()).unwrap(),
+    );
+}
+
+fn tissue_never_breaks(speed: f64) {
+    let mut sim = Simulation::new(
+        phantom_lattice(),
+        SimulationConfig::default(),
+        &MuscleCatalogue::default(),
+    )
+    .unwrap();
+    let tri = sim.lattice().fat.surface_triangles();
+    let (mut inverted, mut crossings, mut finite) = (0usize, 0usize, true);
+    flex_and_back(&mut sim, speed, |s| {
+        let t = s.tissue().unwrap();
+        inverted = inverted.max(s.tissue_metrics().unwrap().inverted);
+        finite &= t.fat_vertices().iter().all(|p| p.is_finite());
+        crossings = crossings.max(self_intersections(t.fat_vertices(), &tri));
+    });
+    assert!(finite, "a fat vertex became non-finite");
+    assert_eq!(
+        (inverted, crossings),
+        (0, 0),
+        "inverted elements, self-intersecting skin triangle pairs"
+    );
+}
+
+#[test]
+#[ignore = "known failure: deep flexion still inverts up to ~200 of 16.5k fat elements and folds the skin behind the knee (issue 4 is open)"]
+fn fat_never_inverts_nor_self_intersects_through_a_deep_flexion() {
+    tissue_never_breaks(1.0);
+}
+
+#[test]
+#[ignore = "known failure: as above, at three times the excitation speed"]
+fn fat_never_inverts_nor_self_intersects_at_three_times_the_speed() {
+    tissue_never_breaks(3.0);
+}
+
+#[test]
+fn every_tissue_vertex_stays_finite_at_three_times_the_speed() {
+    let mut sim = Simulation::new(
+        phantom_lattice(),
+        SimulationConfig::default(),
+        &MuscleCatalogue::default(),
+    )
+    .unwrap();
+    let mut finite = true;
+    flex_and_back(&mut sim, 3.0, |s| {
+        let t = s.tissue().unwrap();
+        finite &= t.fat_vertices().iter().all(|p| p.is_finite());
+        finite &= t
+            .muscles
+            .iter()
+            .all(|m| m.current.iter().all(|p| p.is_finite()));
+    });
+    assert!(finite);
+}

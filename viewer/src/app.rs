@@ -1,0 +1,429 @@
+//! The interactive window: winit event loop, wgpu surface, egui panel, orbit camera.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{Result, anyhow};
+use myoslice::prelude::*;
+use winit::application::ApplicationHandler;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::window::{Window, WindowId};
+
+use crate::camera::{CameraPreset, OrbitCamera};
+use crate::gpu::Gpu;
+use crate::model::ModelSource;
+use crate::render::{DEPTH, RenderSettings, Renderer};
+use crate::scene::{SceneMesh, SceneOptions};
+use crate::ui::{UiAction, UiState};
+
+/// Opens the window on a model (or a scenario) and runs until it is closed.
+pub fn run(source: ModelSource, scenario: Option<PathBuf>) -> Result<()> {
+    let event_loop = EventLoop::new().map_err(|e| {
+        anyhow!("cannot open a window ({e}); without a display, use `viewer --capture out.png`")
+    })?;
+    event_loop.set_control_flow(ControlFlow::Poll);
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(
+        Box::new(event_loop.owned_display_handle()),
+    ));
+    let mut ui = UiState {
+        source: source.clone(),
+        ..UiState::default()
+    };
+    let sim = match load(&source, scenario.as_ref()) {
+        Ok(s) => s,
+        Err(e) => {
+            ui.error = Some(format!("{e:#}\n\nShowing the built-in phantom instead."));
+            ui.source = ModelSource::Phantom;
+            load(&ModelSource::Phantom, None)?
+        }
+    };
+    ui.default_plot(&sim);
+    let mut app = App {
+        instance,
+        gfx: None,
+        sim,
+        ui,
+        scenario,
+        camera: None,
+        drag: None,
+        last: Instant::now(),
+        fatal: None,
+    };
+    event_loop
+        .run_app(&mut app)
+        .map_err(|e| anyhow!("event loop: {e}"))?;
+    match app.fatal {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+fn load(source: &ModelSource, scenario: Option<&PathBuf>) -> Result<Simulation> {
+    if let Some(s) = scenario {
+        let sc = Scenario::from_path(s)?;
+        return sc.build().map_err(|e| anyhow!("{e}"));
+    }
+    source.load(SimulationConfig::default())
+}
+
+struct Gfx {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    gpu: Gpu,
+    config: wgpu::SurfaceConfiguration,
+    renderer: Renderer,
+    msaa: Option<wgpu::TextureView>,
+    depth: wgpu::TextureView,
+    egui_ctx: egui::Context,
+    egui_state: egui_winit::State,
+    egui_renderer: egui_wgpu::Renderer,
+}
+
+struct App {
+    instance: wgpu::Instance,
+    gfx: Option<Gfx>,
+    sim: Simulation,
+    ui: UiState,
+    scenario: Option<PathBuf>,
+    camera: Option<OrbitCamera>,
+    drag: Option<(MouseButton, (f64, f64))>,
+    last: Instant,
+    fatal: Option<anyhow::Error>,
+}
+
+fn targets(
+    gpu: &Gpu,
+    config: &wgpu::SurfaceConfiguration,
+    samples: u32,
+) -> (Option<wgpu::TextureView>, wgpu::TextureView) {
+    let tex = |format, usage, label| {
+        gpu.device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: config.width,
+                    height: config.height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: samples,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+            .create_view(&wgpu::TextureViewDescriptor::default())
+    };
+    let msaa = (samples > 1).then(|| {
+        tex(
+            config.format,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+            "msaa",
+        )
+    });
+    (
+        msaa,
+        tex(DEPTH, wgpu::TextureUsages::RENDER_ATTACHMENT, "depth"),
+    )
+}
+
+impl App {
+    fn init(&mut self, el: &ActiveEventLoop) -> Result<()> {
+        let attrs = Window::default_attributes()
+            .with_title("myoslice")
+            .with_inner_size(winit::dpi::LogicalSize::new(1400.0, 860.0));
+        let window = Arc::new(el.create_window(attrs)?);
+        let surface = self.instance.create_surface(window.clone())?;
+        let gpu = Gpu::with_instance(self.instance.clone(), Some(&surface))?;
+        let size = window.inner_size();
+        let caps = surface.get_capabilities(&gpu.adapter);
+        let mut config = surface
+            .get_default_config(&gpu.adapter, size.width.max(1), size.height.max(1))
+            .ok_or_else(|| anyhow!("the window surface is not supported by {}", gpu.describe()))?;
+        config.format = caps
+            .formats
+            .iter()
+            .copied()
+            .find(|f| f.is_srgb())
+            .unwrap_or(config.format);
+        config.present_mode = wgpu::PresentMode::AutoVsync;
+        surface.configure(&gpu.device, &config);
+        let samples = gpu.msaa_samples(config.format);
+        let renderer = Renderer::new(&gpu, config.format, samples);
+        let (msaa, depth) = targets(&gpu, &config, samples);
+        let egui_ctx = egui::Context::default();
+        let egui_state = egui_winit::State::new(
+            egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            &*window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(gpu.device.limits().max_texture_dimension_2d as usize),
+        );
+        let egui_renderer = egui_wgpu::Renderer::new(
+            &gpu.device,
+            config.format,
+            egui_wgpu::RendererOptions::default(),
+        );
+        self.gfx = Some(Gfx {
+            window,
+            surface,
+            gpu,
+            config,
+            renderer,
+            msaa,
+            depth,
+            egui_ctx,
+            egui_state,
+            egui_renderer,
+        });
+        Ok(())
+    }
+
+    fn scene_options(&self) -> SceneOptions {
+        SceneOptions {
+            color_mode: self.ui.color_mode,
+            visible: self.ui.visible,
+            opacity: self.ui.opacity,
+            selected_muscle: self.ui.selected,
+            ..SceneOptions::default()
+        }
+    }
+
+    fn advance(&mut self) {
+        let now = Instant::now();
+        let real = now.duration_since(self.last).as_secs_f64().min(0.1);
+        self.last = now;
+        self.ui.frame_ms = (real * 1e3) as f32;
+        if self.ui.playing {
+            let t0 = Instant::now();
+            let dt = (real * self.ui.speed).clamp(1e-4, 0.05);
+            if let Err(e) = self.sim.step(dt) {
+                self.ui.playing = false;
+                self.ui.error = Some(format!("{e}"));
+            }
+            self.ui.sim_ms = (t0.elapsed().as_secs_f64() * 1e3) as f32;
+            self.ui.record(&self.sim);
+        }
+    }
+
+    fn act(&mut self, actions: Vec<UiAction>) {
+        for a in actions {
+            let r: Result<()> = match a {
+                UiAction::Reset => load(&self.ui.source, self.scenario.as_ref()).map(|s| {
+                    self.sim = s;
+                    self.ui.default_plot(&self.sim);
+                }),
+                UiAction::Step => self
+                    .sim
+                    .step(0.01)
+                    .map_err(Into::into)
+                    .map(|_| self.ui.record(&self.sim)),
+                UiAction::Preset(p) => p.apply(&mut self.sim),
+                UiAction::Camera(p) => {
+                    self.camera = Some(self.frame_camera(p));
+                    Ok(())
+                }
+                UiAction::Load(src) => match load(&src, None) {
+                    Ok(s) => {
+                        self.sim = s;
+                        self.ui.source = src;
+                        self.scenario = None;
+                        self.ui.default_plot(&self.sim);
+                        self.camera = None;
+                        Ok(())
+                    }
+                    Err(e) => Err(e),
+                },
+            };
+            if let Err(e) = r {
+                self.ui.error = Some(format!("{e:#}"));
+            }
+        }
+    }
+
+    fn frame_camera(&self, preset: CameraPreset) -> OrbitCamera {
+        let s = SceneMesh::build(
+            &self.sim,
+            &SceneOptions {
+                visible: [true, false, true],
+                ..SceneOptions::default()
+            },
+        );
+        OrbitCamera::framing(s.bounds.0, s.bounds.1, preset)
+    }
+
+    fn redraw(&mut self) {
+        self.advance();
+        let Some(g) = self.gfx.as_mut() else { return };
+        let raw = g.egui_state.take_egui_input(&g.window);
+        let ui_state = &mut self.ui;
+        let sim = &mut self.sim;
+        let mut actions = Vec::new();
+        let mut out = g.egui_ctx.run_ui(raw, |ui| {
+            actions = ui_state.show(ui, sim);
+        });
+        g.egui_state
+            .handle_platform_output(&g.window, std::mem::take(&mut out.platform_output));
+        let ppp = out.pixels_per_point;
+        let paint = g.egui_ctx.tessellate(std::mem::take(&mut out.shapes), ppp);
+        for (id, deltas) in out.textures_delta.set.drain() {
+            for d in deltas {
+                g.egui_renderer
+                    .update_texture(&g.gpu.device, &g.gpu.queue, id, &d);
+            }
+        }
+        let frame = match g.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(f)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                g.surface.configure(&g.gpu.device, &g.config);
+                for id in out.textures_delta.free.drain() {
+                    g.egui_renderer.free_texture(&id);
+                }
+                return;
+            }
+            _ => {
+                for id in out.textures_delta.free.drain() {
+                    g.egui_renderer.free_texture(&id);
+                }
+                return;
+            }
+        };
+        let view = frame
+            .texture
+            .create_view(&wgpu::TextureViewDescriptor::default());
+        let opts = SceneOptions {
+            color_mode: self.ui.color_mode,
+            visible: self.ui.visible,
+            opacity: self.ui.opacity,
+            selected_muscle: self.ui.selected,
+            ..SceneOptions::default()
+        };
+        let scene = SceneMesh::build(&self.sim, &opts);
+        let camera = *self.camera.get_or_insert_with(|| {
+            OrbitCamera::framing(scene.bounds.0, scene.bounds.1, CameraPreset::Oblique)
+        });
+        let mut enc = g
+            .gpu
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("frame"),
+            });
+        let (target, resolve) = match &g.msaa {
+            Some(m) => (m, Some(&view)),
+            None => (&view, None),
+        };
+        let size = (g.config.width, g.config.height);
+        g.renderer.draw(
+            &g.gpu,
+            &mut enc,
+            target,
+            resolve,
+            &g.depth,
+            size,
+            &scene,
+            &camera,
+            &RenderSettings { legend: None },
+        );
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [g.config.width, g.config.height],
+            pixels_per_point: ppp,
+        };
+        let extra =
+            g.egui_renderer
+                .update_buffers(&g.gpu.device, &g.gpu.queue, &mut enc, &paint, &screen);
+        {
+            let pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("egui"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Load,
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                ..Default::default()
+            });
+            g.egui_renderer
+                .render(&mut pass.forget_lifetime(), &paint, &screen);
+        }
+        g.gpu.queue.submit(extra.into_iter().chain([enc.finish()]));
+        for id in out.textures_delta.free.drain() {
+            g.egui_renderer.free_texture(&id);
+        }
+        g.window.pre_present_notify();
+        g.gpu.queue.present(frame);
+        self.act(actions);
+        let _ = self.scene_options();
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, el: &ActiveEventLoop) {
+        if self.gfx.is_none()
+            && let Err(e) = self.init(el)
+        {
+            self.fatal = Some(e);
+            el.exit();
+        }
+    }
+
+    fn window_event(&mut self, el: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let Some(g) = self.gfx.as_mut() else { return };
+        let resp = g.egui_state.on_window_event(&g.window, &event);
+        let egui_wants = g.egui_ctx.egui_wants_pointer_input();
+        match event {
+            WindowEvent::CloseRequested => el.exit(),
+            WindowEvent::Resized(s) => {
+                g.config.width = s.width.max(1);
+                g.config.height = s.height.max(1);
+                g.surface.configure(&g.gpu.device, &g.config);
+                let (msaa, depth) = targets(&g.gpu, &g.config, g.renderer.samples);
+                g.msaa = msaa;
+                g.depth = depth;
+            }
+            WindowEvent::RedrawRequested => self.redraw(),
+            WindowEvent::MouseInput { state, button, .. } if !resp.consumed => {
+                self.drag = match state {
+                    ElementState::Pressed if !egui_wants => Some((button, (f64::NAN, f64::NAN))),
+                    _ => None,
+                };
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                if let (Some((button, last)), Some(cam)) =
+                    (self.drag.as_mut(), self.camera.as_mut())
+                {
+                    if last.0.is_finite() {
+                        let (dx, dy) = ((position.x - last.0) as f32, (position.y - last.1) as f32);
+                        match button {
+                            MouseButton::Left => cam.orbit(dx, dy, 0.006),
+                            _ => cam.pan(dx, dy, g.config.height as f32),
+                        }
+                    }
+                    *last = (position.x, position.y);
+                }
+            }
+            WindowEvent::MouseWheel { delta, .. } if !egui_wants => {
+                let lines = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => y,
+                    MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,
+                };
+                if let Some(cam) = self.camera.as_mut() {
+                    cam.zoom((-lines * 0.1).exp());
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn about_to_wait(&mut self, _el: &ActiveEventLoop) {
+        if let Some(g) = &self.gfx {
+            g.window.request_redraw();
+        }
+    }
+}

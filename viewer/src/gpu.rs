@@ -1,0 +1,82 @@
+//! Device creation: headless (no surface) or for a window surface.
+
+/// Why no GPU could be used.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    /// No adapter at all (no driver, no software renderer).
+    #[error(
+        "no graphics adapter found ({0}). Install a GPU driver, or the software renderer: \
+         apt-get install mesa-vulkan-drivers libvulkan1"
+    )]
+    NoAdapter(String),
+    /// The adapter refused a device.
+    #[error("the graphics adapter refused a device: {0}")]
+    Device(String),
+}
+
+/// An adapter, its device and queue.
+#[derive(Debug)]
+pub struct Gpu {
+    /// The instance.
+    pub instance: wgpu::Instance,
+    /// The adapter.
+    pub adapter: wgpu::Adapter,
+    /// The device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+}
+
+impl Gpu {
+    /// A device without any surface (off-screen rendering). Honors `WGPU_BACKEND` and
+    /// `WGPU_ADAPTER_NAME`.
+    pub fn headless() -> Result<Self, GpuError> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        Self::with_instance(instance, None)
+    }
+
+    /// A device for `instance`, compatible with `surface` when given.
+    pub fn with_instance(
+        instance: wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<Self, GpuError> {
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: surface,
+            apply_limit_buckets: false,
+        }))
+        .map_err(|e| GpuError::NoAdapter(e.to_string()))?;
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("myoslice"),
+            required_features: wgpu::Features::empty(),
+            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        }))
+        .map_err(|e| GpuError::Device(e.to_string()))?;
+        Ok(Self {
+            instance,
+            adapter,
+            device,
+            queue,
+        })
+    }
+
+    /// A short description of the adapter.
+    pub fn describe(&self) -> String {
+        let i = self.adapter.get_info();
+        format!("{} ({:?}, {:?})", i.name, i.backend, i.device_type)
+    }
+
+    /// The largest MSAA sample count (1, 2 or 4) supported for `format`.
+    pub fn msaa_samples(&self, format: wgpu::TextureFormat) -> u32 {
+        let f = self.adapter.get_texture_format_features(format).flags;
+        [4, 2]
+            .into_iter()
+            .find(|&n| f.sample_count_supported(n))
+            .unwrap_or(1)
+    }
+}

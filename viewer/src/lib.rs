@@ -1,0 +1,22 @@
+//! The myoslice viewer: an interactive wgpu window over the core `Simulation`, and an
+//! off-screen capture that needs no window or display.
+
+pub mod camera;
+pub mod capture;
+pub mod colormap;
+pub mod gpu;
+pub mod model;
+pub mod render;
+pub mod scene;
+
+#[cfg(feature = "window")]
+pub mod app;
+#[cfg(feature = "window")]
+pub mod ui;
+
+pub use camera::{CameraPreset, OrbitCamera};
+pub use capture::{CaptureOptions, capture_frames, capture_png};
+pub use colormap::ColorMode;
+pub use gpu::{Gpu, GpuError};
+pub use render::{RenderSettings, Renderer};
+pub use scene::{Layer, SceneMesh};

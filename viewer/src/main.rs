@@ -1,0 +1,193 @@
+//! `viewer`: the interactive leg, or an off-screen capture with `--capture`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, anyhow};
+use clap::Parser;
+use myoslice::prelude::*;
+use myoslice_viewer::camera::CameraPreset;
+use myoslice_viewer::capture::{CaptureOptions, capture_frames, capture_png};
+use myoslice_viewer::colormap::ColorMode;
+use myoslice_viewer::model::{ModelSource, Preset};
+use myoslice_viewer::scene::SceneOptions;
+use myoslice_viewer::{Gpu, app};
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "viewer",
+    version,
+    about = "The myoslice leg: interactive, or captured off-screen"
+)]
+struct Args {
+    /// Render off-screen to this PNG instead of opening a window.
+    #[arg(long)]
+    capture: Option<PathBuf>,
+    /// Capture width (pixels).
+    #[arg(long, default_value_t = 1280)]
+    width: u32,
+    /// Capture height (pixels).
+    #[arg(long, default_value_t = 720)]
+    height: u32,
+    /// Scenario file (model, excitations).
+    #[arg(long, conflicts_with_all = ["volume", "labels"])]
+    scenario: Option<PathBuf>,
+    /// NIfTI label volume.
+    #[arg(long, requires = "labels")]
+    volume: Option<PathBuf>,
+    /// Label table for --volume.
+    #[arg(long, requires = "volume")]
+    labels: Option<PathBuf>,
+    /// Simulated time before the capture (s).
+    #[arg(long, default_value_t = 0.0)]
+    time: f64,
+    /// Motion during --time without a scenario: relax, flexion, extension, cocontraction.
+    #[arg(long, default_value = "relax")]
+    preset: String,
+    /// Surface colours: area, degree, none.
+    #[arg(long, default_value = "area")]
+    color: String,
+    /// Viewpoint: front, side, back, medial, oblique.
+    #[arg(long, default_value = "oblique")]
+    camera: String,
+    /// Render an animation of this many frames over --time.
+    #[arg(long)]
+    frames: Option<usize>,
+    /// Folder for the animation's PNG frames.
+    #[arg(long)]
+    out_dir: Option<PathBuf>,
+    /// Animated GIF of the animation.
+    #[arg(long)]
+    gif: Option<PathBuf>,
+    /// Layers to draw, comma separated: bone, muscle, skin.
+    #[arg(long, value_delimiter = ',', default_value = "bone,muscle,skin")]
+    layers: Vec<String>,
+    /// Skin opacity (0..1).
+    #[arg(long, default_value_t = 0.45)]
+    skin_opacity: f32,
+    /// No colour-bar legend in captures.
+    #[arg(long)]
+    no_legend: bool,
+}
+
+fn build(args: &Args) -> Result<Simulation> {
+    if let Some(s) = &args.scenario {
+        let sc = Scenario::from_path(s)?;
+        return sc.build().map_err(|e| anyhow!("{e}"));
+    }
+    let source = match (&args.volume, &args.labels) {
+        (Some(v), Some(l)) => ModelSource::Nifti {
+            volume: v.clone(),
+            labels: l.clone(),
+        },
+        _ => ModelSource::Phantom,
+    };
+    let mut sim = source.load(SimulationConfig::default())?;
+    let preset = Preset::parse(&args.preset).ok_or_else(|| {
+        anyhow!(
+            "unknown --preset '{}': use relax, flexion, extension or cocontraction",
+            args.preset
+        )
+    })?;
+    preset.apply(&mut sim)?;
+    Ok(sim)
+}
+
+fn capture(args: &Args) -> Result<()> {
+    let color = ColorMode::parse(&args.color)
+        .ok_or_else(|| anyhow!("unknown --color '{}': use area, degree or none", args.color))?;
+    let camera = CameraPreset::parse(&args.camera).ok_or_else(|| {
+        anyhow!(
+            "unknown --camera '{}': use front, side, back, medial or oblique",
+            args.camera
+        )
+    })?;
+    if !(16..=8192).contains(&args.width) || !(16..=8192).contains(&args.height) {
+        return Err(anyhow!(
+            "--width and --height must be between 16 and 8192 pixels"
+        ));
+    }
+    if !(args.time.is_finite() && args.time >= 0.0) {
+        return Err(anyhow!("--time must be a finite number of seconds >= 0"));
+    }
+    let mut visible = [false; 3];
+    for l in &args.layers {
+        match l.as_str() {
+            "bone" => visible[0] = true,
+            "muscle" => visible[1] = true,
+            "skin" => visible[2] = true,
+            other => {
+                return Err(anyhow!(
+                    "unknown layer '{other}' in --layers: use bone, muscle, skin"
+                ));
+            }
+        }
+    }
+    let gpu = Gpu::headless()?;
+    let mut sim = build(args)?;
+    let opts = CaptureOptions {
+        width: args.width,
+        height: args.height,
+        camera,
+        scene: SceneOptions {
+            color_mode: color,
+            visible,
+            opacity: [1.0, 1.0, args.skin_opacity.clamp(0.0, 1.0)],
+            ..SceneOptions::default()
+        },
+        legend: !args.no_legend,
+    };
+    if args.frames.is_some() || args.gif.is_some() || args.out_dir.is_some() {
+        let frames = args.frames.unwrap_or(24).max(1);
+        capture_frames(
+            &gpu,
+            &mut sim,
+            &opts,
+            args.time,
+            frames,
+            args.out_dir.as_deref(),
+            args.gif.as_deref(),
+        )?;
+        if let Some(p) = &args.capture {
+            capture_png(&gpu, &sim, &opts, p)?;
+        }
+        return Ok(());
+    }
+    if args.time > 0.0 {
+        sim.step(args.time)?;
+        sim.update_tissue()?;
+    }
+    let path = args
+        .capture
+        .as_ref()
+        .context("--capture needs an output path")?;
+    capture_png(&gpu, &sim, &opts, path)?;
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let args = Args::parse();
+    let offscreen = args.capture.is_some()
+        || args.gif.is_some()
+        || args.out_dir.is_some()
+        || args.frames.is_some();
+    let result = if offscreen {
+        capture(&args)
+    } else {
+        let source = match (&args.volume, &args.labels) {
+            (Some(v), Some(l)) => ModelSource::Nifti {
+                volume: v.clone(),
+                labels: l.clone(),
+            },
+            _ => ModelSource::Phantom,
+        };
+        app::run(source, args.scenario.clone())
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("viewer: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

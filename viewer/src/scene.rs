@@ -1,0 +1,254 @@
+//! CPU-side meshes of the simulation, ready to upload: bones, muscles and the body surface
+//! coloured by its per-element metrics.
+
+use std::ops::Range;
+
+use glam::Vec3;
+use myoslice::Simulation;
+use myoslice::body::{BodyId, body_of_bone};
+
+use crate::colormap::{self, ColorMode};
+
+/// One vertex as the shader reads it.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Vertex {
+    /// Position (world, m).
+    pub pos: [f32; 3],
+    /// Unit normal.
+    pub normal: [f32; 3],
+    /// Linear RGBA.
+    pub color: [f32; 4],
+}
+
+/// Drawn layers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Layer {
+    /// Bones.
+    Bone = 0,
+    /// Muscles.
+    Muscle = 1,
+    /// The body surface (skin over the fat).
+    Skin = 2,
+}
+
+/// What to draw and how.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SceneOptions {
+    /// Colour of the body surface.
+    pub color_mode: ColorMode,
+    /// Visibility of bone, muscle, skin.
+    pub visible: [bool; 3],
+    /// Opacity of bone, muscle, skin.
+    pub opacity: [f32; 3],
+    /// Muscle highlighted (index in the simulation's muscle order).
+    pub selected_muscle: Option<usize>,
+    /// Half-width of the area-change scale in log2(A/A0) (None: 1, i.e. ×2 and ×½).
+    pub area_range: Option<f32>,
+    /// Fixed scale for deformation degree, m (None: from the data).
+    pub degree_range: Option<f32>,
+}
+
+impl Default for SceneOptions {
+    fn default() -> Self {
+        Self {
+            color_mode: ColorMode::Area,
+            visible: [true, true, true],
+            opacity: [1.0, 1.0, 0.45],
+            selected_muscle: None,
+            area_range: None,
+            degree_range: None,
+        }
+    }
+}
+
+/// Meshes of one frame.
+#[derive(Debug, Clone, Default)]
+pub struct SceneMesh {
+    /// All vertices.
+    pub vertices: Vec<Vertex>,
+    /// Triangle indices.
+    pub indices: Vec<u32>,
+    /// Index range of each layer (bone, muscle, skin).
+    pub ranges: [Range<u32>; 3],
+    /// Bounding box of everything.
+    pub bounds: (Vec3, Vec3),
+    /// Scale used for the surface colours (log2 area ratio, or degree in m).
+    pub color_range: f32,
+}
+
+/// Area-weighted vertex normals of a triangle set.
+pub fn vertex_normals(v: &[Vec3], tris: &[[u32; 3]]) -> Vec<Vec3> {
+    let mut n = vec![Vec3::ZERO; v.len()];
+    for t in tris {
+        let [a, b, c] = t.map(|i| v[i as usize]);
+        let f = (b - a).cross(c - a);
+        for &i in t {
+            n[i as usize] += f;
+        }
+    }
+    n.iter().map(|x| x.normalize_or(Vec3::Z)).collect()
+}
+
+impl SceneMesh {
+    fn push_mesh(&mut self, v: &[Vec3], tris: &[[u32; 3]], color: [f32; 4]) {
+        let base = self.vertices.len() as u32;
+        let normals = vertex_normals(v, tris);
+        self.vertices
+            .extend(v.iter().zip(&normals).map(|(p, n)| Vertex {
+                pos: p.to_array(),
+                normal: n.to_array(),
+                color,
+            }));
+        self.indices
+            .extend(tris.iter().flat_map(|t| t.map(|i| base + i)));
+    }
+
+    /// Builds the frame of a simulation.
+    pub fn build(sim: &Simulation, opts: &SceneOptions) -> Self {
+        let mut s = SceneMesh::default();
+        let lat = sim.lattice();
+        let frames = sim.frames();
+        // Bones, moved with their bodies.
+        let start = s.indices.len() as u32;
+        if opts.visible[0] {
+            let c = colormap::BONE;
+            for b in &lat.bones {
+                let body = body_of_bone(&b.name);
+                let v: Vec<Vec3> = b
+                    .mesh
+                    .vertices
+                    .iter()
+                    .map(|p| frames.point(body, *p))
+                    .collect();
+                s.push_mesh(&v, &b.mesh.triangles, [c[0], c[1], c[2], opts.opacity[0]]);
+            }
+        }
+        s.ranges[0] = start..s.indices.len() as u32;
+        // Muscles: their deformed shapes when the tissue runs.
+        let start = s.indices.len() as u32;
+        if opts.visible[1] {
+            for (i, m) in sim.muscles().iter().enumerate() {
+                let lm = &lat.muscles[m.lattice_index];
+                let c = if opts.selected_muscle == Some(i) {
+                    [0.98, 0.78, 0.15]
+                } else {
+                    colormap::MUSCLE
+                };
+                let color = [c[0], c[1], c[2], opts.opacity[1]];
+                match sim.tissue() {
+                    Some(t) => s.push_mesh(&t.muscles[i].current, &lm.mesh.triangles, color),
+                    None => {
+                        let body = m.chain.origin.body;
+                        let v: Vec<Vec3> = lm
+                            .mesh
+                            .vertices
+                            .iter()
+                            .map(|p| frames.point(body, *p))
+                            .collect();
+                        s.push_mesh(&v, &lm.mesh.triangles, color);
+                    }
+                }
+            }
+        }
+        s.ranges[1] = start..s.indices.len() as u32;
+        // Skin: the outer faces of the fat, one flat colour per element.
+        let start = s.indices.len() as u32;
+        let fat_x: Vec<Vec3> = match sim.tissue() {
+            Some(t) => t.fat_vertices().to_vec(),
+            None => lat
+                .fat
+                .vertices
+                .iter()
+                .map(|p| {
+                    let body = if p.z < sim.skeleton().knee().point.z {
+                        BodyId::Shank
+                    } else {
+                        BodyId::Thigh
+                    };
+                    frames.point(body, *p)
+                })
+                .collect(),
+        };
+        let faces = lat.fat.outer_faces();
+        let metrics = sim.tissue_metrics();
+        let (values, range): (Vec<f32>, f32) = match (opts.color_mode, metrics) {
+            (ColorMode::Area, Some(m)) => {
+                let v: Vec<f32> = faces
+                    .iter()
+                    .map(|(h, _)| m.area_change[*h as usize])
+                    .collect();
+                (v, opts.area_range.unwrap_or(1.0))
+            }
+            (ColorMode::Degree, Some(m)) => {
+                let v: Vec<f32> = faces
+                    .iter()
+                    .map(|(h, _)| m.deformation_degree[*h as usize])
+                    .collect();
+                let r = opts
+                    .degree_range
+                    .unwrap_or_else(|| colormap::robust_range(&v, 1e-3));
+                (v, r)
+            }
+            _ => (vec![0.0; faces.len()], 1.0),
+        };
+        s.color_range = range;
+        if opts.visible[2] {
+            let tris: Vec<[u32; 3]> = faces
+                .iter()
+                .flat_map(|(_, q)| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+                .collect();
+            let normals = vertex_normals(&fat_x, &tris);
+            for ((_, q), val) in faces.iter().zip(&values) {
+                let c = match opts.color_mode {
+                    ColorMode::None => colormap::SKIN,
+                    ColorMode::Area if metrics.is_some() => colormap::area_color(*val, range),
+                    ColorMode::Degree if metrics.is_some() => colormap::degree_color(*val, range),
+                    _ => colormap::SKIN,
+                };
+                let base = s.vertices.len() as u32;
+                for &i in q {
+                    s.vertices.push(Vertex {
+                        pos: fat_x[i as usize].to_array(),
+                        normal: normals[i as usize].to_array(),
+                        color: [c[0], c[1], c[2], opts.opacity[2]],
+                    });
+                }
+                s.indices
+                    .extend([base, base + 1, base + 2, base, base + 2, base + 3]);
+            }
+        }
+        s.ranges[2] = start..s.indices.len() as u32;
+        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for p in fat_x
+            .iter()
+            .chain(lat.bones.iter().flat_map(|b| b.mesh.vertices.iter()))
+        {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        s.bounds = (lo, hi);
+        s
+    }
+
+    /// Triangle count of a layer.
+    pub fn triangles(&self, layer: Layer) -> usize {
+        self.ranges[layer as usize].len() / 3
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normals_of_a_tetrahedron_point_outward() {
+        let v = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+        let t = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+        let n = vertex_normals(&v, &t);
+        let c = Vec3::splat(0.25);
+        for (p, nn) in v.iter().zip(&n) {
+            assert!((*p - c).dot(*nn) > 0.0);
+        }
+    }
+}

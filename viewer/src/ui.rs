@@ -1,0 +1,439 @@
+//! The control panel: playback, excitation sliders by group, presets, layers and colour
+//! maps, a live plot, readouts and error dialogs. State is plain data, testable without a
+//! window.
+
+use std::collections::VecDeque;
+
+use myoslice::Simulation;
+use myoslice::muscle::MuscleGroup;
+
+use crate::camera::CameraPreset;
+use crate::colormap::ColorMode;
+use crate::model::{ModelSource, Preset};
+
+/// Samples kept for the live plot.
+pub const HISTORY: usize = 600;
+
+/// Time series for the live plot.
+#[derive(Debug, Clone, Default)]
+pub struct History {
+    /// Time (s).
+    pub t: VecDeque<f64>,
+    /// Knee angle (deg).
+    pub angle: VecDeque<f64>,
+    /// Force (N) of each plotted muscle, in the order of `UiState::plotted`.
+    pub forces: Vec<VecDeque<f64>>,
+}
+
+impl History {
+    /// Appends a sample, dropping the oldest beyond [`HISTORY`].
+    pub fn push(&mut self, t: f64, angle_deg: f64, forces: &[f64]) {
+        if self.forces.len() != forces.len() {
+            self.forces = vec![VecDeque::new(); forces.len()];
+            self.t.clear();
+            self.angle.clear();
+        }
+        self.t.push_back(t);
+        self.angle.push_back(angle_deg);
+        for (q, f) in self.forces.iter_mut().zip(forces) {
+            q.push_back(*f);
+        }
+        while self.t.len() > HISTORY {
+            self.t.pop_front();
+            self.angle.pop_front();
+            for q in &mut self.forces {
+                q.pop_front();
+            }
+        }
+    }
+
+    /// Drops everything.
+    pub fn clear(&mut self) {
+        *self = Self::default();
+    }
+}
+
+/// What the user asked for this frame, for the app to carry out.
+#[derive(Debug, Clone, PartialEq)]
+pub enum UiAction {
+    /// Rebuild the simulation from its source.
+    Reset,
+    /// Advance one step of 10 ms while paused.
+    Step,
+    /// Apply a preset motion.
+    Preset(Preset),
+    /// Load another model.
+    Load(ModelSource),
+    /// Move the camera to a preset view.
+    Camera(CameraPreset),
+}
+
+/// Everything the panel shows and edits.
+#[derive(Debug, Clone)]
+pub struct UiState {
+    /// Simulation running.
+    pub playing: bool,
+    /// Simulated seconds per real second.
+    pub speed: f64,
+    /// Body-surface colours.
+    pub color_mode: ColorMode,
+    /// Layer visibility: bone, muscle, skin.
+    pub visible: [bool; 3],
+    /// Layer opacity.
+    pub opacity: [f32; 3],
+    /// Highlighted muscle.
+    pub selected: Option<usize>,
+    /// Muscles in the force plot.
+    pub plotted: Vec<usize>,
+    /// Live plot data.
+    pub history: History,
+    /// An error to show in a dialog.
+    pub error: Option<String>,
+    /// Last frame time (ms) and simulation time per frame (ms).
+    pub frame_ms: f32,
+    /// Wall time of the last simulation advance (ms).
+    pub sim_ms: f32,
+    /// Path fields of the "open model" form.
+    pub open_volume: String,
+    /// Label table path of the form.
+    pub open_labels: String,
+    /// The model shown.
+    pub source: ModelSource,
+}
+
+impl Default for UiState {
+    fn default() -> Self {
+        Self {
+            playing: true,
+            speed: 0.5,
+            color_mode: ColorMode::Area,
+            visible: [true, true, true],
+            opacity: [1.0, 1.0, 0.45],
+            selected: None,
+            plotted: Vec::new(),
+            history: History::default(),
+            error: None,
+            frame_ms: 0.0,
+            sim_ms: 0.0,
+            open_volume: String::new(),
+            open_labels: String::new(),
+            source: ModelSource::Phantom,
+        }
+    }
+}
+
+impl UiState {
+    /// Chooses the default plotted muscles: the largest flexor and extensor.
+    pub fn default_plot(&mut self, sim: &Simulation) {
+        let pick = |g: MuscleGroup| {
+            sim.muscles()
+                .iter()
+                .enumerate()
+                .filter(|(_, m)| m.group == g && m.crosses_knee)
+                .max_by(|a, b| {
+                    a.1.hill
+                        .max_isometric_force
+                        .total_cmp(&b.1.hill.max_isometric_force)
+                })
+                .map(|(i, _)| i)
+        };
+        self.plotted = [pick(MuscleGroup::Flexor), pick(MuscleGroup::Extensor)]
+            .into_iter()
+            .flatten()
+            .collect();
+        self.history.clear();
+    }
+
+    /// Records the simulation's state for the plot.
+    pub fn record(&mut self, sim: &Simulation) {
+        let forces: Vec<f64> = self
+            .plotted
+            .iter()
+            .map(|&i| sim.muscles()[i].force)
+            .collect();
+        self.history
+            .push(sim.time(), sim.knee_angle().to_degrees(), &forces);
+    }
+
+    /// Draws the panel; returns the actions to carry out.
+    pub fn show(&mut self, ui: &mut egui::Ui, sim: &mut Simulation) -> Vec<UiAction> {
+        let mut actions = Vec::new();
+        egui::Panel::left("controls")
+            .resizable(true)
+            .default_size(330.0)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| {
+                    ui.heading("myoslice");
+                    ui.label(self.source.describe());
+                    self.readouts(ui, sim);
+                    ui.separator();
+                    self.playback(ui, &mut actions);
+                    ui.separator();
+                    self.muscles(ui, sim, &mut actions);
+                    ui.separator();
+                    self.display(ui, &mut actions);
+                    ui.separator();
+                    self.plot(ui, sim);
+                    ui.separator();
+                    self.open_form(ui, &mut actions);
+                });
+            });
+        let ctx = ui.ctx().clone();
+        let mut close = false;
+        if let Some(msg) = &self.error {
+            egui::Window::new("Error")
+                .collapsible(false)
+                .resizable(false)
+                .anchor(egui::Align2::CENTER_CENTER, [0.0, 0.0])
+                .show(&ctx, |ui| {
+                    ui.label(msg.as_str());
+                    if ui.button("OK").clicked() {
+                        close = true;
+                    }
+                });
+        }
+        if close {
+            self.error = None;
+        }
+        actions
+    }
+
+    fn readouts(&self, ui: &mut egui::Ui, sim: &Simulation) {
+        let lat = sim.lattice();
+        egui::Grid::new("readouts").num_columns(2).show(ui, |ui| {
+            ui.label("time");
+            ui.label(format!("{:.3} s", sim.time()));
+            ui.end_row();
+            ui.label("knee angle");
+            ui.label(format!(
+                "{:.1}°  ({:+.0}°/s)",
+                sim.knee_angle().to_degrees(),
+                sim.knee_velocity().to_degrees()
+            ));
+            ui.end_row();
+            ui.label("knee torque");
+            ui.label(format!("{:+.1} N·m", sim.knee_torque()));
+            ui.end_row();
+            ui.label("frame / sim");
+            ui.label(format!("{:.1} ms / {:.1} ms", self.frame_ms, self.sim_ms));
+            ui.end_row();
+            ui.label("elements");
+            ui.label(format!(
+                "{} fat hex, {} muscles, {} bones",
+                lat.fat.hexes.len(),
+                lat.muscles.len(),
+                lat.bones.len()
+            ));
+            ui.end_row();
+            if let Some(m) = sim.tissue_metrics() {
+                ui.label("tissue");
+                ui.label(format!(
+                    "min vol {:.2}, max |ΔA| {:.2}, inverted {}",
+                    m.min_volume_ratio, m.max_abs_area_change, m.inverted
+                ));
+                ui.end_row();
+            }
+        });
+    }
+
+    fn playback(&mut self, ui: &mut egui::Ui, actions: &mut Vec<UiAction>) {
+        ui.horizontal(|ui| {
+            if ui
+                .button(if self.playing {
+                    "⏸ Pause"
+                } else {
+                    "▶ Play"
+                })
+                .clicked()
+            {
+                self.playing = !self.playing;
+            }
+            if ui.button("Step").clicked() {
+                actions.push(UiAction::Step);
+            }
+            if ui.button("Reset").clicked() {
+                actions.push(UiAction::Reset);
+            }
+        });
+        ui.add(
+            egui::Slider::new(&mut self.speed, 0.05..=2.0)
+                .logarithmic(true)
+                .text("speed (× real time)"),
+        );
+        ui.horizontal_wrapped(|ui| {
+            for (p, name) in [
+                (Preset::Flexion, "Knee flexion"),
+                (Preset::Extension, "Extension"),
+                (Preset::CoContraction, "Co-contraction"),
+                (Preset::Relax, "Relax"),
+            ] {
+                if ui.button(name).clicked() {
+                    actions.push(UiAction::Preset(p));
+                }
+            }
+        });
+    }
+
+    fn muscles(&mut self, ui: &mut egui::Ui, sim: &mut Simulation, _actions: &mut Vec<UiAction>) {
+        ui.label("Excitation");
+        for (group, title) in [
+            (MuscleGroup::Flexor, "Flexors"),
+            (MuscleGroup::Extensor, "Extensors"),
+            (MuscleGroup::Other, "Others"),
+        ] {
+            egui::CollapsingHeader::new(title)
+                .default_open(group != MuscleGroup::Other)
+                .show(ui, |ui| {
+                    let names: Vec<(usize, String, f64, f64)> = sim
+                        .muscles()
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, m)| m.group == group)
+                        .map(|(i, m)| (i, m.name.clone(), m.excitation, m.force))
+                        .collect();
+                    for (i, name, mut e, f) in names {
+                        ui.horizontal(|ui| {
+                            let sel = self.selected == Some(i);
+                            if ui.selectable_label(sel, &name).clicked() {
+                                self.selected = if sel { None } else { Some(i) };
+                            }
+                            if ui
+                                .add(egui::Slider::new(&mut e, 0.0..=1.0).show_value(true))
+                                .changed()
+                            {
+                                let _ = sim.set_excitation(&name, e);
+                            }
+                            ui.label(format!("{f:.0} N"));
+                        });
+                    }
+                });
+        }
+    }
+
+    fn display(&mut self, ui: &mut egui::Ui, actions: &mut Vec<UiAction>) {
+        ui.label("Display");
+        egui::ComboBox::from_label("surface colour")
+            .selected_text(match self.color_mode {
+                ColorMode::Area => "area change",
+                ColorMode::Degree => "deformation degree",
+                ColorMode::None => "none",
+            })
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut self.color_mode, ColorMode::Area, "area change");
+                ui.selectable_value(
+                    &mut self.color_mode,
+                    ColorMode::Degree,
+                    "deformation degree",
+                );
+                ui.selectable_value(&mut self.color_mode, ColorMode::None, "none");
+            });
+        for (i, name) in ["bone", "muscle", "skin"].iter().enumerate() {
+            ui.horizontal(|ui| {
+                ui.checkbox(&mut self.visible[i], *name);
+                ui.add(egui::Slider::new(&mut self.opacity[i], 0.05..=1.0).text("opacity"));
+            });
+        }
+        ui.horizontal_wrapped(|ui| {
+            ui.label("camera:");
+            for (p, name) in CameraPreset::ALL {
+                if ui.button(name).clicked() {
+                    actions.push(UiAction::Camera(p));
+                }
+            }
+        });
+        match self.color_mode {
+            ColorMode::Area => {
+                ui.label(
+                    egui::RichText::new("white: no change · blue: surface grew · red: shrank")
+                        .small(),
+                );
+            }
+            ColorMode::Degree => {
+                ui.label(
+                    egui::RichText::new("white: undeformed → dark orange: most deformed (Eq. 5)")
+                        .small(),
+                );
+            }
+            ColorMode::None => {}
+        }
+    }
+
+    fn plot(&mut self, ui: &mut egui::Ui, sim: &Simulation) {
+        ui.label("Knee angle (°) and muscle forces (N / 20)");
+        let t: Vec<f64> = self.history.t.iter().copied().collect();
+        let angle: egui_plot::PlotPoints = t
+            .iter()
+            .zip(&self.history.angle)
+            .map(|(t, a)| [*t, *a])
+            .collect();
+        let forces: Vec<(String, egui_plot::PlotPoints)> = self
+            .plotted
+            .iter()
+            .zip(&self.history.forces)
+            .map(|(&i, q)| {
+                let pts: egui_plot::PlotPoints =
+                    t.iter().zip(q).map(|(t, f)| [*t, *f / 20.0]).collect();
+                (sim.muscles()[i].name.clone(), pts)
+            })
+            .collect();
+        egui_plot::Plot::new("history")
+            .height(170.0)
+            .legend(egui_plot::Legend::default())
+            .show(ui, |p| {
+                p.line(egui_plot::Line::new("knee angle", angle));
+                for (name, pts) in forces {
+                    p.line(egui_plot::Line::new(name, pts));
+                }
+            });
+    }
+
+    fn open_form(&mut self, ui: &mut egui::Ui, actions: &mut Vec<UiAction>) {
+        egui::CollapsingHeader::new("Open model")
+            .default_open(false)
+            .show(ui, |ui| {
+                ui.horizontal(|ui| {
+                    ui.label("volume");
+                    ui.text_edit_singleline(&mut self.open_volume);
+                });
+                ui.horizontal(|ui| {
+                    ui.label("labels");
+                    ui.text_edit_singleline(&mut self.open_labels);
+                });
+                ui.horizontal(|ui| {
+                    if ui.button("Load NIfTI").clicked() {
+                        actions.push(UiAction::Load(ModelSource::Nifti {
+                            volume: self.open_volume.trim().into(),
+                            labels: self.open_labels.trim().into(),
+                        }));
+                    }
+                    if ui.button("Phantom").clicked() {
+                        actions.push(UiAction::Load(ModelSource::Phantom));
+                    }
+                });
+            });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn history_keeps_a_bounded_window_and_resets_on_new_muscles() {
+        let mut h = History::default();
+        for k in 0..HISTORY + 50 {
+            h.push(k as f64, 1.0, &[2.0, 3.0]);
+        }
+        assert_eq!(h.t.len(), HISTORY);
+        assert_eq!(h.t[0], 50.0);
+        assert_eq!(h.forces.len(), 2);
+        h.push(0.0, 0.0, &[1.0]);
+        assert_eq!((h.t.len(), h.forces.len()), (1, 1));
+    }
+
+    #[test]
+    fn default_state_plays_and_colours_by_area() {
+        let s = UiState::default();
+        assert!(s.playing && s.color_mode == ColorMode::Area && s.visible.iter().all(|v| *v));
+    }
+}
