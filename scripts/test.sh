@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
 # Every test of myoslice, from a fresh machine: system packages (software Vulkan for the
-# off-screen viewer capture), Rust format/lint/tests, and the Python package in its own
-# virtual environment. Usage: scripts/test.sh
+# off-screen viewer capture), Rust format/lint/tests, then the Python package built as a
+# wheel into a fresh virtual environment and its pytest suite (bindings, Gymnasium env,
+# stubs, scenario runs and their ParaView/Blender outputs).
+# Usage: scripts/test.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
+start=$(date +%s)
 
-step() { printf '\n==> %s\n' "$*"; }
+step() { printf '\n==> %s (%ss)\n' "$*" "$(( $(date +%s) - start ))"; }
 
 # --- system packages -------------------------------------------------------------------
 need_pkgs=()
@@ -14,11 +17,10 @@ dpkg -s mesa-vulkan-drivers >/dev/null 2>&1 || need_pkgs+=(mesa-vulkan-drivers)
 dpkg -s libvulkan1 >/dev/null 2>&1 || need_pkgs+=(libvulkan1)
 if [ ${#need_pkgs[@]} -gt 0 ]; then
   step "installing ${need_pkgs[*]} (software Vulkan for off-screen rendering)"
-  if [ "$(id -u)" = 0 ]; then
-    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${need_pkgs[@]}"
-  else
-    sudo apt-get update -qq && sudo DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${need_pkgs[@]}"
-  fi
+  sudo_cmd=""
+  [ "$(id -u)" = 0 ] || sudo_cmd="sudo"
+  $sudo_cmd apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq "${need_pkgs[@]}"
 fi
 
 # --- Rust ------------------------------------------------------------------------------
@@ -26,8 +28,24 @@ step "cargo fmt --check"
 cargo fmt --all -- --check
 step "cargo clippy (warnings are errors)"
 cargo clippy --workspace --all-targets -- -D warnings
-step "cargo test"
-cargo test --workspace
+step "cargo test (core, CLI, viewer incl. off-screen capture on the software adapter)"
+# The Python crate is tested through its wheel below (its test binary would embed Python).
+cargo test --workspace --exclude myoslice-py
+step "release CLI (reference for the Python parity tests, scenario runs)"
+cargo build --release -p myoslice-cli
 
-echo
-echo "all tests passed"
+# --- Python ----------------------------------------------------------------------------
+step "fresh virtual environment with the test requirements"
+rm -rf .venv-test
+python3 -m venv .venv-test
+.venv-test/bin/python -m pip install -q --upgrade pip
+.venv-test/bin/python -m pip install -q "maturin>=1.9.4,<2" -r python/requirements-test.txt
+step "building and installing the wheel"
+rm -rf target/wheels
+.venv-test/bin/maturin build --release -m python/Cargo.toml -o target/wheels
+.venv-test/bin/python -m pip install -q --force-reinstall --no-deps target/wheels/myoslice-*.whl
+step "pytest"
+# From the repository root, so that the installed wheel (not python/myoslice/) is imported.
+.venv-test/bin/python -m pytest -q python/tests
+
+step "all tests passed"

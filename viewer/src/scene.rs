@@ -136,19 +136,7 @@ impl SceneMesh {
                     colormap::MUSCLE
                 };
                 let color = [c[0], c[1], c[2], opts.opacity[1]];
-                match sim.tissue() {
-                    Some(t) => s.push_mesh(&t.muscles[i].current, &lm.mesh.triangles, color),
-                    None => {
-                        let body = m.chain.origin.body;
-                        let v: Vec<Vec3> = lm
-                            .mesh
-                            .vertices
-                            .iter()
-                            .map(|p| frames.point(body, *p))
-                            .collect();
-                        s.push_mesh(&v, &lm.mesh.triangles, color);
-                    }
-                }
+                s.push_mesh(&sim.muscle_vertices(i), &lm.mesh.triangles, color);
             }
         }
         s.ranges[1] = start..s.indices.len() as u32;

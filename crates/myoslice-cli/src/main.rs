@@ -6,6 +6,8 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use clap::{Args, Parser, Subcommand};
 use myoslice::BuildReport;
+
+mod bench;
 use myoslice::prelude::*;
 
 #[derive(Parser)]
@@ -23,10 +25,57 @@ struct Cli {
 enum Command {
     /// Build the lattice body and report how well it matches the voxels.
     Build(BuildArgs),
+    /// Run a scenario: VTU/PVD frames, an animated GLB, timeseries.csv and summary.json.
+    Run(RunArgs),
+    /// Time the standard cases (lattice build, muscle step, fat kernel, whole leg).
+    Bench(BenchArgs),
+    /// Step the phantom and print exact results as JSON (reference for the Python tests).
+    Probe(ProbeArgs),
     /// Write axial slices of the model, coloured by label, side by side to a PNG.
     Slices(SlicesArgs),
     /// Measure a phantom definition (per-level outlines) from a labelled volume.
     PhantomMeasure(MeasureArgs),
+}
+
+#[derive(Args)]
+struct RunArgs {
+    /// Scenario file (TOML).
+    scenario: PathBuf,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
+    /// No progress bar.
+    #[arg(long)]
+    quiet: bool,
+    /// Override the scenario's duration (s), e.g. for a quick check.
+    #[arg(long)]
+    duration: Option<f64>,
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Also time the Visible Human build from ../shared/data (path to the folder).
+    #[arg(long)]
+    visible_human: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct ProbeArgs {
+    /// Steps of --dt.
+    #[arg(long, default_value_t = 1000)]
+    steps: u64,
+    /// Step (s).
+    #[arg(long, default_value_t = 0.001)]
+    dt: f64,
+    /// Excitations NAME=VALUE.
+    #[arg(long)]
+    excite: Vec<String>,
+    /// Deform the tissue too.
+    #[arg(long)]
+    tissue: bool,
 }
 
 #[derive(Args)]
@@ -169,6 +218,108 @@ fn build(args: &BuildArgs) -> Result<()> {
     Ok(())
 }
 
+fn run_scenario(a: &RunArgs) -> Result<()> {
+    use myoslice::export::{RunOutputs, RunWriter};
+    let mut sc = Scenario::from_path(&a.scenario)?;
+    if let Some(d) = a.duration {
+        anyhow::ensure!(
+            d.is_finite() && d > 0.0,
+            "--duration {d}: expected a duration > 0 s"
+        );
+        sc.simulation.duration_s = d;
+    }
+    let t0 = Instant::now();
+    let mut sim = sc.build()?;
+    let outputs = RunOutputs {
+        vtu: sc.output.vtu,
+        glb: sc.output.glb,
+    };
+    let mut w = RunWriter::create(&a.out, &sim, outputs)?;
+    let duration = sc.simulation.duration_s;
+    let dt = sc.simulation.step_s;
+    let steps = (duration / dt).round().max(1.0) as u64;
+    let frames = sc.output.frames.max(1) as u64;
+    let row_every = ((0.01 / dt).round() as u64).max(1);
+    let bar = if a.quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new(steps)
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {msg}  eta {eta}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let mut next_frame = 1;
+    for k in 1..=steps {
+        sim.step(dt)?;
+        if k % row_every == 0 || k == steps {
+            w.row(&sim)?;
+        }
+        if k * frames >= next_frame * steps {
+            sim.update_tissue()?;
+            w.frame(&sim)?;
+            next_frame += 1;
+            bar.set_message(format!("knee {:.1}°", sim.knee_angle().to_degrees()));
+        }
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let summary = w.finish(&sim, t0.elapsed().as_secs_f64())?;
+    if !a.quiet {
+        println!(
+            "{:.2} s simulated in {:.2} s ({:.2}x real time): knee {:.1}..{:.1}°, {} frames -> {}",
+            summary.duration_s,
+            summary.wall_time_s,
+            summary.realtime_factor,
+            summary.knee_angle_range_deg[0],
+            summary.knee_angle_range_deg[1],
+            summary.frames,
+            a.out.display()
+        );
+    }
+    Ok(())
+}
+
+fn probe(a: &ProbeArgs) -> Result<()> {
+    let mut cfg = SimulationConfig::default();
+    cfg.tissue.enabled = a.tissue;
+    let mut sim = Simulation::phantom(cfg)?;
+    for e in &a.excite {
+        let (n, v) = e
+            .split_once('=')
+            .with_context(|| format!("--excite {e}: expected NAME=VALUE"))?;
+        sim.set_excitation(
+            n,
+            v.parse()
+                .with_context(|| format!("--excite {e}: bad number"))?,
+        )?;
+    }
+    let t0 = Instant::now();
+    for _ in 0..a.steps {
+        sim.step(a.dt)?;
+    }
+    let wall = t0.elapsed().as_secs_f64();
+    let list = |v: Vec<f64>| {
+        format!(
+            "[{}]",
+            v.iter()
+                .map(|x| format!("{x:?}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    };
+    println!(
+        "{{\"time\": {:?}, \"knee_angle\": {:?}, \"knee_velocity\": {:?}, \"forces\": {}, \"activations\": {}, \"wall_s\": {:?}}}",
+        sim.time(),
+        sim.knee_angle(),
+        sim.knee_velocity(),
+        list(sim.muscles().iter().map(|m| m.force).collect()),
+        list(sim.muscles().iter().map(|m| m.activation).collect()),
+        wall
+    );
+    Ok(())
+}
+
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     match run(&cli) {
@@ -183,6 +334,9 @@ fn main() -> std::process::ExitCode {
 fn run(cli: &Cli) -> Result<()> {
     match &cli.command {
         Command::Build(a) => build(a),
+        Command::Run(a) => run_scenario(a),
+        Command::Bench(a) => bench::run(a.json, a.visible_human.as_deref()),
+        Command::Probe(a) => probe(a),
         Command::Slices(a) => {
             let (vol, table, _) = load(&a.model)?;
             let ks = myoslice::export::write_axial_slices(&vol, &table, &a.z_mm, &a.out)?;

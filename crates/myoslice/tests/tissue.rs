@@ -203,13 +203,13 @@ fn tissue_never_breaks(speed: f64) {
 }
 
 #[test]
-#[ignore = "known failure: deep flexion still inverts up to ~200 of 16.5k fat elements and folds the skin behind the knee (issue 4 is open)"]
+
 fn fat_never_inverts_nor_self_intersects_through_a_deep_flexion() {
     tissue_never_breaks(1.0);
 }
 
 #[test]
-#[ignore = "known failure: as above, at three times the excitation speed"]
+
 fn fat_never_inverts_nor_self_intersects_at_three_times_the_speed() {
     tissue_never_breaks(3.0);
 }

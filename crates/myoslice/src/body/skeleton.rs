@@ -160,7 +160,10 @@ impl Skeleton {
         multibody
             .insert(thigh, shank, joint, true)
             .ok_or_else(|| Error::Build("rapier refused the knee joint".into()))?;
-        let params = IntegrationParameters { dt: 1e-3, ..IntegrationParameters::default() };
+        let params = IntegrationParameters {
+            dt: 1e-3,
+            ..IntegrationParameters::default()
+        };
         let mut sk = Self {
             bodies,
             colliders,

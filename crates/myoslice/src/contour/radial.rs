@@ -22,7 +22,9 @@ pub enum PolygonMethod {
 pub struct RegionPolygon {
     /// The polygon, `rays` vertices, counter-clockwise.
     pub polygon: Polygon,
-    /// The point rays start from (the region centroid).
+    /// The ring's centre: the region centroid for radial polygons (where the rays start);
+    /// for traced ones a point well inside the polygon (a C-shape's centroid lies in its
+    /// hole, and a tiny region's may sit on its own border).
     pub centre: [f64; 2],
     /// Intersection over union with the region's pixels.
     pub iou: f64,
@@ -78,9 +80,10 @@ pub fn polygonise(mask: &impl Mask, region: &Region, rays: usize, min_iou: f64) 
         let traced = resample_loop(lp, rays, c);
         let traced_iou = iou(&traced, mask, b, region.area);
         if traced_iou > radial_iou || degenerate {
+            let centre = interior_centre(&traced, b, c);
             return RegionPolygon {
                 polygon: traced,
-                centre: c,
+                centre,
                 iou: traced_iou,
                 method: PolygonMethod::Traced,
             };
@@ -92,6 +95,53 @@ pub fn polygonise(mask: &impl Mask, region: &Region, rays: usize, min_iou: f64) 
         iou: radial_iou,
         method: PolygonMethod::Radial,
     }
+}
+
+/// A point well inside the polygon: the centroid where it lies at least a pixel inside,
+/// else the point farthest from the border, searched on the pixel grid over `bbox` and
+/// refined on a quarter-pixel grid about the best pixel.
+fn interior_centre(poly: &Polygon, bbox: [u32; 4], centroid: [f64; 2]) -> [f64; 2] {
+    let p = &poly.points;
+    let clearance = |x: f64, y: f64| -> f64 {
+        let mut best = f64::INFINITY;
+        for i in 0..p.len() {
+            let (a, b) = (p[i], p[(i + 1) % p.len()]);
+            let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+            let len2 = (dx * dx + dy * dy).max(1e-18);
+            let t = (((x - a[0]) * dx + (y - a[1]) * dy) / len2).clamp(0.0, 1.0);
+            let (ex, ey) = (a[0] + t * dx - x, a[1] + t * dy - y);
+            best = best.min(ex * ex + ey * ey);
+        }
+        best
+    };
+    let inside = |x: f64, y: f64| poly.contains(x, y);
+    let mut best = (0.0, centroid);
+    if inside(centroid[0], centroid[1]) {
+        let d = clearance(centroid[0], centroid[1]);
+        if d >= 1.0 {
+            return centroid;
+        }
+        best = (d, centroid);
+    }
+    let search = |x0: f64, y0: f64, nx: usize, ny: usize, h: f64, best: &mut (f64, [f64; 2])| {
+        for iy in 0..=ny {
+            for ix in 0..=nx {
+                let (x, y) = (x0 + h * ix as f64, y0 + h * iy as f64);
+                if inside(x, y) {
+                    let d = clearance(x, y);
+                    if d > best.0 {
+                        *best = (d, [x, y]);
+                    }
+                }
+            }
+        }
+    };
+    let (u0, v0) = (f64::from(bbox[0]), f64::from(bbox[1]));
+    let (nu, nv) = ((bbox[2] - bbox[0]) as usize, (bbox[3] - bbox[1]) as usize);
+    search(u0, v0, nu, nv, 1.0, &mut best);
+    let c = best.1;
+    search(c[0] - 1.0, c[1] - 1.0, 8, 8, 0.25, &mut best);
+    best.1
 }
 
 #[cfg(test)]
@@ -145,6 +195,11 @@ mod tests {
         assert!(
             !p.polygon.contains(40.0, 40.0),
             "the hole (bone) must stay outside"
+        );
+        assert!(
+            p.polygon.contains(p.centre[0], p.centre[1]),
+            "the ring centre {:?} lies inside the C, not in its hole",
+            p.centre
         );
     }
 }

@@ -9,3 +9,8 @@ pub use vtu::{CellType, VtuMesh, write_atomic, write_pvd};
 pub mod body_vtu;
 
 pub use body_vtu::{BodyPositions, FatScalars, body_vtu, rest_vtu};
+pub mod gltf;
+pub mod run;
+
+pub use gltf::{MorphMesh, RigidMesh, encode_glb};
+pub use run::{RunOutputs, RunSummary, RunWriter};

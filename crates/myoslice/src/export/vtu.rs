@@ -86,7 +86,7 @@ impl VtuMesh {
         let _ = writeln!(s, "<?xml version=\"1.0\"?>");
         let _ = writeln!(
             s,
-            "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt32\">"
+            "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt32\" compressor=\"vtkZLibDataCompressor\">"
         );
         let _ = writeln!(s, "<UnstructuredGrid>");
         let _ = writeln!(
@@ -184,14 +184,24 @@ fn bytes_f32(v: &[f32]) -> Vec<u8> {
     v.iter().flat_map(|x| x.to_le_bytes()).collect()
 }
 
+/// One inline binary array, zlib-compressed as VTK reads it: a base64 header
+/// `[blocks = 1, block size, last block size, compressed size]` (UInt32), then the
+/// base64 of the compressed block.
 fn array(s: &mut String, ty: &str, name: &str, comps: usize, data: Vec<u8>) {
-    let mut payload = (data.len() as u32).to_le_bytes().to_vec();
-    payload.extend_from_slice(&data);
+    let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::fast());
+    let _ = z.write_all(&data);
+    let compressed = z.finish().unwrap_or_default();
+    let n = data.len() as u32;
+    let header: Vec<u8> = [1u32, n, n, compressed.len() as u32]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
     let _ = writeln!(
         s,
-        "<DataArray type=\"{ty}\" Name=\"{}\" NumberOfComponents=\"{comps}\" format=\"binary\">{}</DataArray>",
+        "<DataArray type=\"{ty}\" Name=\"{}\" NumberOfComponents=\"{comps}\" format=\"binary\">{}{}</DataArray>",
         xml_escape(name),
-        base64(&payload)
+        base64(&header),
+        base64(&compressed)
     );
 }
 

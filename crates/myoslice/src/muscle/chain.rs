@@ -18,7 +18,10 @@ pub struct Attachment {
 }
 
 /// A cone restricting an interior chain point: apex on the bone surface (the centre of
-/// the nearest bone triangle at rest), axis through the point at rest.
+/// the nearest bone triangle at rest), axis through the point at rest. Beyond the paper,
+/// the point also keeps near its rest depth from the apex (`depth`): the tissue around a
+/// muscle holds it there, and a chain under tension would otherwise bowstring through
+/// its neighbours.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ConeAnchor {
     /// Body carrying the apex.
@@ -27,6 +30,29 @@ pub struct ConeAnchor {
     pub apex: Vec3,
     /// Unit axis at rest.
     pub axis: Vec3,
+    /// Smallest and largest distance (m) from the apex.
+    pub depth: [f32; 2],
+}
+
+/// How far (share of the rest depth, at least [`DEPTH_SLACK_MIN`]) a cone-anchored point
+/// may move toward or away from its apex.
+pub const DEPTH_SLACK: f32 = 0.25;
+
+/// Least depth slack (m).
+pub const DEPTH_SLACK_MIN: f32 = 0.005;
+
+impl ConeAnchor {
+    /// A cone at `apex` through `point` (rest), on `body`.
+    pub fn new(body: BodyId, apex: Vec3, axis: Vec3, point: Vec3) -> Self {
+        let d = point.distance(apex);
+        let slack = (DEPTH_SLACK * d).max(DEPTH_SLACK_MIN);
+        Self {
+            body,
+            apex,
+            axis,
+            depth: [(d - slack).max(0.0), d + slack],
+        }
+    }
 }
 
 /// Body poses as seen by the chains: rotation and translation of each body.
@@ -421,7 +447,8 @@ impl MuscleChain {
                 if let Some(c) = self.cones[i] {
                     let apex = fr.point(c.body, c.apex);
                     let axis = fr.vector(c.body, c.axis);
-                    self.x[i] = project_into_cone(self.x[i], apex, axis, self.cone_cos_tan);
+                    let p = project_into_cone(self.x[i], apex, axis, self.cone_cos_tan);
+                    self.x[i] = clamp_depth(p, apex, c.depth);
                     // Position-based correction: the velocity follows the projected motion.
                     self.v[i] = (self.x[i] - old) / h;
                 }
@@ -525,6 +552,17 @@ impl MuscleChain {
             }
         }
     }
+}
+
+/// `p` moved along the line from `apex` so that its distance from it lies in `depth`.
+pub fn clamp_depth(p: Vec3, apex: Vec3, depth: [f32; 2]) -> Vec3 {
+    let w = p - apex;
+    let d = w.length();
+    if d < 1e-9 {
+        return p;
+    }
+    let c = d.clamp(depth[0], depth[1]);
+    if c == d { p } else { apex + w * (c / d) }
 }
 
 /// Closest point of the cone (apex, unit axis, half-angle given by its cosine and

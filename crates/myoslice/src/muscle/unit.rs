@@ -232,11 +232,12 @@ impl MuscleUnit {
                 let axis = (x[i] - apex)
                     .try_normalize()
                     .unwrap_or_else(|| (t.b - t.a).cross(t.c - t.a).normalize_or(Vec3::Z));
-                Some(ConeAnchor {
-                    body: body_of_bone(&lattice.bones[bone].name),
+                Some(ConeAnchor::new(
+                    body_of_bone(&lattice.bones[bone].name),
                     apex,
                     axis,
-                })
+                    x[i],
+                ))
             })
             .collect();
         let o_body_early = body_of_bone(&lattice.bones[ob].name);

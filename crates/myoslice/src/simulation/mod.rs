@@ -3,6 +3,7 @@
 
 mod config;
 mod schedule;
+mod surface;
 
 use std::sync::Arc;
 
@@ -10,6 +11,7 @@ use glam::Vec3;
 
 pub use config::{MuscleModel, SimulationConfig};
 pub use schedule::Schedule;
+pub use surface::{Layer, Surface};
 
 use crate::body::{BodyId, Skeleton, SkeletonOptions, knee_axis};
 use crate::error::{Error, Result, check_positive, check_range};
@@ -249,6 +251,11 @@ impl Simulation {
     /// Simulated time (s).
     pub fn time(&self) -> f64 {
         self.time
+    }
+
+    /// Muscle steps taken so far.
+    pub fn steps(&self) -> u64 {
+        self.steps
     }
 
     /// Knee flexion angle (rad).

@@ -8,7 +8,7 @@
 use glam::{Mat3, Quat, Vec3};
 use rayon::prelude::*;
 
-use super::polar::{covariance, extract_rotation};
+use super::polar::rotation_step;
 
 /// Elements per parallel block.
 const BLOCK: usize = 2048;
@@ -31,8 +31,13 @@ pub struct FatSolver {
     /// Vertex → element corners (`hex * 8 + corner`), CSR.
     inc_start: Vec<u32>,
     inc: Vec<u32>,
-    /// Whether a vertex is moved by the solver (false: set by a constraint).
+    /// Whether a vertex is moved by the solver (false: set by a constraint, or outside
+    /// the region being relaxed).
     pub free: Vec<bool>,
+    /// Whether an element's goal is computed (every element touching a free vertex).
+    pub active: Vec<bool>,
+    /// Volume of each element at rest (m³).
+    pub rest_volume: Vec<f64>,
 }
 
 impl FatSolver {
@@ -63,7 +68,12 @@ impl FatSolver {
                 fill[v as usize] += 1;
             }
         }
+        let rest_volume = hexes
+            .iter()
+            .map(|h| crate::lattice::hex_volume_points(&h.map(|i| rest[i as usize].as_dvec3())))
+            .collect();
         Self {
+            rest_volume,
             rest: rest.to_vec(),
             x: rest.to_vec(),
             hexes: hexes.to_vec(),
@@ -73,7 +83,46 @@ impl FatSolver {
             inc_start: count,
             inc,
             free: vec![true; rest.len()],
+            active: vec![true; hexes.len()],
         }
+    }
+
+    /// A block of `nx × ny × nz` cubic cells of edge `cell` (m), for tests and benchmarks.
+    ///
+    /// ```
+    /// use myoslice::tissue::FatSolver;
+    /// let mut s = FatSolver::grid(20, 7, 6, 0.01);
+    /// assert_eq!(s.len(), 840);
+    /// s.iterate(0.5);
+    /// ```
+    pub fn grid(nx: usize, ny: usize, nz: usize, cell: f32) -> Self {
+        let idx = |i: usize, j: usize, k: usize| (i + (nx + 1) * (j + (ny + 1) * k)) as u32;
+        let mut v = Vec::with_capacity((nx + 1) * (ny + 1) * (nz + 1));
+        for k in 0..=nz {
+            for j in 0..=ny {
+                for i in 0..=nx {
+                    v.push(Vec3::new(i as f32, j as f32, k as f32) * cell);
+                }
+            }
+        }
+        let mut h = Vec::with_capacity(nx * ny * nz);
+        for k in 0..nz {
+            for j in 0..ny {
+                for i in 0..nx {
+                    h.push([
+                        idx(i, j, k),
+                        idx(i + 1, j, k),
+                        idx(i + 1, j + 1, k),
+                        idx(i, j + 1, k),
+                        idx(i, j, k + 1),
+                        idx(i + 1, j, k + 1),
+                        idx(i + 1, j + 1, k + 1),
+                        idx(i, j + 1, k + 1),
+                    ]);
+                }
+            }
+        }
+        Self::new(&v, &h)
     }
 
     /// One shape-matching iteration: element goals, then every free vertex moves a
@@ -106,26 +155,42 @@ impl FatSolver {
             });
     }
 
-    /// Goals of every element from the current positions (rotation warm-started).
+    /// Goals of every element from the current positions (rotation warm-started, one
+    /// trigonometry-free iteration per pass).
     pub fn compute_goals(&mut self) {
         let x = &self.x;
         let hexes = &self.hexes;
         let rel = &self.rel;
+        let active = &self.active;
         self.goals
             .par_chunks_mut(BLOCK)
             .zip(self.rot.par_chunks_mut(BLOCK))
             .enumerate()
             .for_each(|(b, (goals, rots))| {
+                let base = b * BLOCK;
                 for (o, (g, q)) in goals.iter_mut().zip(rots.iter_mut()).enumerate() {
-                    let e = b * BLOCK + o;
+                    let e = base + o;
+                    if !active[e] {
+                        continue;
+                    }
                     let h = &hexes[e];
                     let r = &rel[e];
-                    let p = h.map(|i| x[i as usize]);
-                    let c = (p[0] + p[1] + p[2] + p[3] + p[4] + p[5] + p[6] + p[7]) * 0.125;
-                    let d = p.map(|pi| pi - c);
-                    let a = covariance(&d, r);
-                    *q = extract_rotation(&a, *q, 1);
-                    let m = Mat3::from_quat(*q);
+                    let mut p = [Vec3::ZERO; 8];
+                    let mut c = Vec3::ZERO;
+                    for k in 0..8 {
+                        p[k] = x[h[k] as usize];
+                        c += p[k];
+                    }
+                    c *= 0.125;
+                    let (mut a0, mut a1, mut a2) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
+                    for k in 0..8 {
+                        let d = p[k] - c;
+                        a0 += d * r[k].x;
+                        a1 += d * r[k].y;
+                        a2 += d * r[k].z;
+                    }
+                    let (q2, m) = rotation_step(&Mat3::from_cols(a0, a1, a2), *q);
+                    *q = q2;
                     for k in 0..8 {
                         g[k] = c + m * r[k];
                     }
@@ -133,27 +198,33 @@ impl FatSolver {
             });
     }
 
-    /// Goals of the listed elements only.
-    pub fn compute_goals_for(&mut self, elements: &[usize]) {
-        for &e in elements {
-            let h = self.hexes[e];
-            let r = &self.rel[e];
-            let p = h.map(|i| self.x[i as usize]);
-            let c = p.iter().copied().sum::<Vec3>() / 8.0;
-            let d = p.map(|pi| pi - c);
-            let a = covariance(&d, r);
-            let q = extract_rotation(&a, self.rot[e], 8);
-            self.rot[e] = q;
-            let m = Mat3::from_quat(q);
-            for k in 0..8 {
-                self.goals[e][k] = c + m * r[k];
+    /// Relaxes only where the shape can change: elements with a `moving` vertex and
+    /// their corners (elsewhere the lattice moves rigidly and shape matching would
+    /// leave it as it is). Marks the corners free and every element touching one active.
+    pub fn restrict_to(&mut self, moving: &[bool]) {
+        self.free.iter_mut().for_each(|f| *f = false);
+        for h in &self.hexes {
+            if h.iter().any(|&v| moving[v as usize]) {
+                for &v in h {
+                    self.free[v as usize] = true;
+                }
             }
+        }
+        for (a, h) in self.active.iter_mut().zip(&self.hexes) {
+            *a = h.iter().any(|&v| self.free[v as usize]);
         }
     }
 
-    /// Goal of corner `k` of element `e` (after a goals pass).
-    pub fn goal(&self, e: usize, k: usize) -> Vec3 {
-        self.goals[e][k]
+    /// Relaxes everywhere again (see [`Self::restrict_to`]).
+    pub fn release(&mut self) {
+        self.free.iter_mut().for_each(|f| *f = true);
+        self.active.iter_mut().for_each(|a| *a = true);
+    }
+
+    /// The elements with vertex `v` as a corner.
+    pub fn elements_of(&self, v: usize) -> impl Iterator<Item = usize> + '_ {
+        let (s, e) = (self.inc_start[v] as usize, self.inc_start[v + 1] as usize);
+        self.inc[s..e].iter().map(|&c| (c >> 3) as usize)
     }
 
     /// Rest-relative corner vectors of element `e`.
@@ -176,40 +247,10 @@ impl FatSolver {
 mod tests {
     use super::*;
 
-    fn block(nx: usize, ny: usize, nz: usize) -> (Vec<Vec3>, Vec<[u32; 8]>) {
-        let idx = |i: usize, j: usize, k: usize| (i + (nx + 1) * (j + (ny + 1) * k)) as u32;
-        let mut v = Vec::new();
-        for k in 0..=nz {
-            for j in 0..=ny {
-                for i in 0..=nx {
-                    v.push(Vec3::new(i as f32, j as f32, k as f32) * 0.01);
-                }
-            }
-        }
-        let mut h = Vec::new();
-        for k in 0..nz {
-            for j in 0..ny {
-                for i in 0..nx {
-                    h.push([
-                        idx(i, j, k),
-                        idx(i + 1, j, k),
-                        idx(i + 1, j + 1, k),
-                        idx(i, j + 1, k),
-                        idx(i, j, k + 1),
-                        idx(i + 1, j, k + 1),
-                        idx(i + 1, j + 1, k + 1),
-                        idx(i, j + 1, k + 1),
-                    ]);
-                }
-            }
-        }
-        (v, h)
-    }
-
     #[test]
     fn a_perturbed_block_returns_to_its_rest_shape_up_to_a_rigid_motion() {
-        let (v, h) = block(4, 3, 3);
-        let mut s = FatSolver::new(&v, &h);
+        let mut s = FatSolver::grid(4, 3, 3, 0.01);
+        let v = s.rest.clone();
         // Rotate everything, then perturb.
         let q = Quat::from_axis_angle(Vec3::new(0.3, 1.0, 0.2).normalize(), 0.8);
         for (i, p) in s.x.iter_mut().enumerate() {

@@ -3,7 +3,9 @@
 use glam::{Mat3, Vec3};
 
 use super::Tissue;
-use super::polar::{covariance, polar_rotation_exact};
+use rayon::prelude::*;
+
+use super::polar::{covariance, polar_rotation_exact, rotation_step};
 use crate::lattice::{Lattice, hex_volume_points, quad_area};
 
 /// Metrics of the tissue at one moment; arrays are contiguous, one value per fat
@@ -26,34 +28,68 @@ pub struct TissueMetrics {
     pub max_abs_area_change: f32,
     /// Elements of zero or negative volume.
     pub inverted: usize,
+    /// Fat vertices the validity guard moved off the relaxed shape toward the knee fold
+    /// in the last update (0: the elastic relaxation stood everywhere).
+    pub guarded_vertices: usize,
 }
 
 impl TissueMetrics {
-    /// Measures the tissue now.
+    /// Measures the tissue now, every element.
     pub fn measure(lattice: &Lattice, t: &Tissue) -> Self {
+        Self::measure_where(lattice, t, None)
+    }
+
+    /// Measures the elements the last update relaxed ([`super::FatSolver::active`]); the
+    /// others moved rigidly with a bone, so they have no deformation, no area change and
+    /// their rest volume.
+    pub fn measure_active(lattice: &Lattice, t: &Tissue) -> Self {
+        Self::measure_where(lattice, t, Some(&t.fat.active))
+    }
+
+    fn measure_where(lattice: &Lattice, t: &Tissue, only: Option<&[bool]>) -> Self {
         let fat = &t.fat;
         let n = fat.hexes.len();
-        let mut volume_ratio = vec![1.0f32; n];
-        let mut degree = vec![0.0f32; n];
-        let mut inverted = 0;
-        for e in 0..n {
-            let h = fat.hexes[e];
-            let p = h.map(|i| fat.x[i as usize]);
-            let v = hex_volume_points(&p.map(Vec3::as_dvec3));
-            let v0 = hex_volume_points(&h.map(|i| fat.rest[i as usize].as_dvec3()));
-            volume_ratio[e] = (v / v0) as f32;
-            if v <= 0.0 {
-                inverted += 1;
+        let mut skip = vec![false; n];
+        if let Some(only) = only {
+            for (s, a) in skip.iter_mut().zip(only) {
+                *s = !a;
             }
-            let c = p.iter().copied().sum::<Vec3>() / 8.0;
-            let d = p.map(|q| q - c);
-            let r = fat.rest_relative(e);
-            let q = polar_rotation_exact(&covariance(&d, r), fat.rot[e]);
-            let m = Mat3::from_quat(q);
-            degree[e] = (0..8).map(|k| (m * r[k] - d[k]).length()).sum::<f32>() / 8.0;
         }
+        // Volume ratio and deformation degree per element, in parallel.
+        let per: Vec<(f32, f32)> = (0..n)
+            .into_par_iter()
+            .map(|e| {
+                if skip[e] {
+                    return (1.0, 0.0);
+                }
+                let h = fat.hexes[e];
+                let p = h.map(|i| fat.x[i as usize]);
+                let v = hex_volume_points(&p.map(Vec3::as_dvec3));
+                let c = p.iter().copied().sum::<Vec3>() / 8.0;
+                let d = p.map(|q| q - c);
+                let r = fat.rest_relative(e);
+                let a = covariance(&d, r);
+                // After an update the solver's rotation is warm: two trigonometry-free
+                // steps reach float precision. A hand-made state may be far from it.
+                let q = if only.is_some() {
+                    let (q, _) = rotation_step(&a, fat.rot[e]);
+                    rotation_step(&a, q).0
+                } else {
+                    polar_rotation_exact(&a, fat.rot[e])
+                };
+                let m = Mat3::from_quat(q);
+                let degree = (0..8).map(|k| (m * r[k] - d[k]).length()).sum::<f32>() / 8.0;
+                ((v / fat.rest_volume[e]) as f32, degree)
+            })
+            .collect();
+        let volume_ratio: Vec<f32> = per.iter().map(|p| p.0).collect();
+        let degree: Vec<f32> = per.iter().map(|p| p.1).collect();
+        let inverted = volume_ratio.iter().filter(|&&r| r <= 0.0).count();
         let mut area_change = vec![0.0f32; n];
         for (h, quad) in lattice.fat.outer_faces() {
+            if skip[h as usize] {
+                continue;
+            }
             let a0 = quad_area(&fat.rest, &quad);
             let a = quad_area(&fat.x, &quad);
             if a0 > 0.0 {
@@ -73,6 +109,7 @@ impl TissueMetrics {
             volume_ratio,
             muscle_volume_ratio,
             inverted,
+            guarded_vertices: 0,
         }
     }
 }

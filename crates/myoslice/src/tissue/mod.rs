@@ -1,23 +1,25 @@
 //! Tissue deformation: constant-volume muscles riding on their chains, shape-matching fat
-//! that follows muscles and bones, a contact plane behind the knee, and the per-element
-//! metrics of the paper (section 5.3).
+//! that follows muscles and bones, the knee fold and contact plane behind the knee, a
+//! validity guard, and the per-element metrics of the paper (section 5.3).
 
 pub mod fat_solver;
 pub mod intersect;
+pub mod knee_fold;
 pub mod metrics;
 pub mod muscle_shape;
 pub mod polar;
 
 use std::sync::Arc;
 
-use glam::{Quat, Vec3};
+use glam::Vec3;
 use parry3d::query::PointQuery;
 use parry3d::shape::TriMesh;
 use serde::{Deserialize, Serialize};
 
 pub use fat_solver::FatSolver;
+pub use knee_fold::{Contact, KneeFold};
 pub use metrics::TissueMetrics;
-pub use muscle_shape::{Contact, KneeField, MuscleShape};
+pub use muscle_shape::MuscleShape;
 
 use crate::body::{BodyId, KneeAxis, body_of_bone};
 use crate::error::{Result, check_range};
@@ -43,9 +45,13 @@ pub struct TissueConfig {
     /// Half-gap (m) kept between the thigh and calf sides of the contact plane behind
     /// the knee. Default 0.001.
     pub contact_gap_m: f64,
-    /// Half-width (m) of the band about the knee over which fat follows the shank's
-    /// rotation as a first guess. Default 0.06.
-    pub blend_m: f64,
+    /// No fat element may shrink below this share of its rest volume (or of its volume
+    /// in the knee fold, if that is smaller): where relaxation would, the tissue falls
+    /// back toward the fold locally (see [`Tissue`]). Default 0.05.
+    pub min_volume_ratio: f64,
+    /// Keep the body surface from passing through itself near the knee (checked exactly,
+    /// triangle against triangle, after every update). Default true.
+    pub surface_guard: bool,
 }
 
 impl Default for TissueConfig {
@@ -57,7 +63,8 @@ impl Default for TissueConfig {
             stiffness: 0.6,
             momentum: 0.3,
             contact_gap_m: 0.001,
-            blend_m: 0.06,
+            min_volume_ratio: 0.05,
+            surface_guard: true,
         }
     }
 }
@@ -70,13 +77,28 @@ impl TissueConfig {
         check_range("tissue.stiffness", self.stiffness, 1e-3, 1.0)?;
         check_range("tissue.momentum", self.momentum, 0.0, 0.95)?;
         check_range("tissue.contact_gap_m", self.contact_gap_m, 0.0, 0.01)?;
-        check_range("tissue.blend_m", self.blend_m, 0.005, 0.3)?;
+        check_range("tissue.min_volume_ratio", self.min_volume_ratio, 0.0, 0.9)?;
         Ok(())
     }
 }
 
 /// Extra distance (m) from the contact plane per fat layer below the skin.
 const LAYER_GAP: f32 = 0.001;
+
+/// Body-surface triangles behind the knee and within this distance (m) of it at rest are
+/// guarded against crossing; farther out the tissue moves nearly rigidly with its bone.
+const GUARD_RADIUS: f32 = 0.25;
+
+/// Rounds in which the validity guard halves the relaxation of offending vertices before
+/// it puts them on the fold outright.
+const GUARD_HALVINGS: usize = 2;
+
+/// Squared distance (m²) from the fold below which a fat vertex counts as moving
+/// rigidly with its bone.
+const RIGID_TOLERANCE_M2: f32 = 1e-12;
+
+/// Most rounds of the validity guard (each settles at least one more vertex).
+const GUARD_MAX_ROUNDS: usize = 64;
 
 /// Bone surfaces for tissue queries: body and mesh (rest frame) of each lattice bone.
 pub type BoneSurfaces = Arc<Vec<(BodyId, TriMesh)>>;
@@ -95,8 +117,12 @@ pub struct Tissue {
     bone_ref: Vec<Option<(u32, f32)>>,
     /// Fat vertex side of the knee: +1 thigh, −1 shank.
     side: Vec<f32>,
-    /// Fraction of the shank's rotation each fat vertex takes as a first guess.
-    follow: Vec<f32>,
+    /// Whether a fat vertex lies behind the knee axis at rest (the contact acts there).
+    posterior: Vec<bool>,
+    /// Body-surface triangles near the knee, checked for crossings after each update.
+    guard_triangles: Vec<[u32; 3]>,
+    /// Where each inner vertex facing a muscle is pulled this update (scratch).
+    muscle_targets: Vec<(u32, Vec3)>,
     /// Motion of the last update beyond the skinned guess (for momentum).
     drift: Vec<Vec3>,
     knee: KneeAxis,
@@ -158,13 +184,18 @@ impl Tissue {
             .iter()
             .map(|p| if p.z >= kz { 1.0 } else { -1.0 })
             .collect();
-        let b = config.blend_m as f32;
-        let follow = fat
-            .vertices
-            .iter()
-            .map(|p| {
-                let t = ((kz + b - p.z) / (2.0 * b)).clamp(0.0, 1.0);
-                t * t * (3.0 - 2.0 * t)
+        let fold = KneeFold::new(&knee, 0.0);
+        let posterior = fat.vertices.iter().map(|&p| fold.is_posterior(p)).collect();
+        // Behind the knee, where the thigh and calf press on each other; in front the
+        // skin only stretches.
+        let guard_triangles = fat
+            .surface_triangles()
+            .into_iter()
+            .filter(|t| {
+                t.iter().any(|&v| {
+                    let p = fat.vertices[v as usize];
+                    p.distance(knee.point) < GUARD_RADIUS && fold.is_posterior(p)
+                })
             })
             .collect();
         let mut tissue = Self {
@@ -175,7 +206,9 @@ impl Tissue {
             muscle_ref,
             bone_ref,
             side,
-            follow,
+            posterior,
+            guard_triangles,
+            muscle_targets: Vec::new(),
             knee,
             theta: 0.0,
             layers: fat.layers,
@@ -232,25 +265,19 @@ impl Tissue {
         frames: &BodyFrames,
         muscles: &[MuscleUnit],
     ) {
-        let field = KneeField {
-            point: self.knee.point,
-            axis: self.knee.axis,
-            theta: knee_angle as f32,
-            band: self.config.blend_m as f32,
-        };
         let theta = knee_angle as f32;
-        let knee_pt = frames.point(BodyId::Thigh, self.knee.point);
-        let axis = frames.vector(BodyId::Thigh, self.knee.axis);
+        let fold = KneeFold::new(&self.knee, theta);
+        let (tq, tt) = frames.thigh;
         let gap = self.config.contact_gap_m as f32;
         // Muscles keep further from the contact than the fat over them.
         let muscle_gap = gap + LAYER_GAP * (self.layers as f32 + 1.0);
-        let contact = Contact::new(
-            knee_pt,
-            axis,
-            frames.vector(BodyId::Thigh, Vec3::Z),
-            theta,
-            muscle_gap,
-        );
+        let contact = fold.contact(muscle_gap);
+        let contact = Contact {
+            point: tq * contact.point + tt,
+            normal: tq * contact.normal,
+            behind: tq * contact.behind,
+            ..contact
+        };
         // Muscles are not pushed by the contact plane: their volume is the invariant
         // kept; the fat over them is.
         for (shape, m) in self.muscles.iter_mut().zip(muscles) {
@@ -264,40 +291,50 @@ impl Tissue {
                     };
                     shape.carry(q, t);
                 }
-                _ => shape.update(&m.chain, &field, None),
+                _ => shape.update(&m.chain, &fold, None),
             }
         }
-        // First guess, from the rest shape (so nothing accumulates): every vertex turns
-        // about the knee by its share of the shank's rotation; each radial column of
-        // vertices then moves with its inner vertex where that follows a muscle; part of
-        // the last update's correction is carried over (inertia with damping).
+        // The fold of the rest shape is valid: the fallback of the guard below.
+        let (folded, weights) = knee_fold::fold_hexes(&fold, &self.fat.rest, &self.fat.hexes);
+        let safe: Vec<Vec3> = folded.into_iter().map(|p| tq * p + tt).collect();
+        // Where each inner vertex facing a muscle goes: with its reference muscle vertex,
+        // keeping its rest offset from it turned as the tissue about it turns (the
+        // paper's moving vector alone would shear thin fat at large angles).
+        self.muscle_targets.clear();
+        for (v, r) in self.muscle_ref.iter().enumerate() {
+            let Some((m, mv)) = *r else { continue };
+            let shape = &self.muscles[m as usize];
+            let turn = tq * glam::Quat::from_axis_angle(fold.axis, theta * weights[v]);
+            let offset = self.fat.rest[v] - shape.rest[mv as usize];
+            self.muscle_targets
+                .push((v as u32, shape.current[mv as usize] + turn * offset));
+        }
+        // First guess, from the fold (so nothing accumulates): each radial column of
+        // vertices moves with its inner vertex where that follows a muscle; part of the
+        // last update's correction is carried over (inertia with damping).
         let momentum = self.config.momentum as f32;
         let lat = &lattice.fat;
-        let mut guess = vec![Vec3::ZERO; self.fat.x.len()];
-        for (i, g) in guess.iter_mut().enumerate() {
-            let q = Quat::from_axis_angle(axis, theta * self.follow[i]);
-            *g = knee_pt + q * (self.fat.rest[i] - self.knee.point);
-        }
-        let layers = lat.layers;
-        for s in 0..lat.slices {
-            for j in 0..lat.rays {
-                let inner = lat.vertex_index(s, j, 0) as usize;
-                let Some((m, mv)) = self.muscle_ref[inner] else {
-                    continue;
-                };
-                let shape = &self.muscles[m as usize];
-                let target =
-                    self.fat.rest[inner] + (shape.current[mv as usize] - shape.rest[mv as usize]);
-                let delta = target - guess[inner];
-                for l in 0..=layers {
-                    let v = lat.vertex_index(s, j, l) as usize;
-                    guess[v] += delta * (1.0 - 0.5 * l as f32 / layers as f32);
-                }
+        let mut guess = safe.clone();
+        let l1 = lat.layers + 1;
+        for &(inner, target) in &self.muscle_targets {
+            // Inner vertices are layer 0 of their column (see `FatLattice::vertex_index`).
+            let inner = inner as usize;
+            let delta = target - guess[inner];
+            for l in 0..l1 {
+                guess[inner + l] += delta * (1.0 - 0.5 * l as f32 / lat.layers as f32);
             }
         }
         for (i, p) in self.fat.x.iter_mut().enumerate() {
             *p = guess[i] + self.drift[i] * momentum;
         }
+        // Relax only where the fat does not simply move with a bone.
+        let moving: Vec<bool> = (0..safe.len())
+            .map(|i| {
+                (weights[i] > 0.0 && weights[i] < 1.0)
+                    || self.fat.x[i].distance_squared(safe[i]) > RIGID_TOLERANCE_M2
+            })
+            .collect();
+        self.fat.restrict_to(&moving);
         self.apply_muscles();
         self.apply_contact(&contact, gap);
         let k = self.config.stiffness as f32;
@@ -308,12 +345,13 @@ impl Tissue {
         }
         self.apply_bones(frames);
         self.apply_contact(&contact, gap);
-        self.guard_inversions(&contact, gap);
+        let guarded = self.guard(&safe);
         for i in 0..self.drift.len() {
             self.drift[i] = self.fat.x[i] - guess[i];
         }
         self.theta = theta;
-        self.metrics = TissueMetrics::measure(lattice, self);
+        self.metrics = TissueMetrics::measure_active(lattice, self);
+        self.metrics.guarded_vertices = guarded;
     }
 
     /// Pulls inner vertices facing a muscle toward their reference muscle vertex's moving
@@ -322,15 +360,9 @@ impl Tissue {
     /// rest.
     fn apply_muscles(&mut self) {
         const PULL: f32 = 0.7;
-        let (x, rest, shapes) = (&mut self.fat.x, &self.fat.rest, &self.muscles);
-        for (v, r) in self.muscle_ref.iter().enumerate() {
-            if let Some((m, mv)) = *r {
-                let s = &shapes[m as usize];
-                let mv = mv as usize;
-                let target = rest[v] + (s.current[mv] - s.rest[mv]);
-                let cur = x[v];
-                x[v] = cur + (target - cur) * PULL;
-            }
+        for &(v, target) in &self.muscle_targets {
+            let cur = self.fat.x[v as usize];
+            self.fat.x[v as usize] = cur + (target - cur) * PULL;
         }
     }
 
@@ -338,6 +370,9 @@ impl Tissue {
     fn apply_contact(&mut self, c: &Contact, gap: f32) {
         let l1 = self.layers + 1;
         for (v, (p, &s)) in self.fat.x.iter_mut().zip(&self.side).enumerate() {
+            if !self.posterior[v] {
+                continue;
+            }
             // Deeper layers stop further from the contact, so squeezed elements stay
             // thin but never flat.
             let depth = (self.layers - v % l1) as f32;
@@ -348,6 +383,9 @@ impl Tissue {
     fn apply_bones(&mut self, frames: &BodyFrames) {
         for (v, r) in self.bone_ref.iter().enumerate() {
             let Some((b, d0)) = *r else { continue };
+            if !self.fat.free[v] {
+                continue; // moves rigidly with its bone already
+            }
             let (body, mesh) = &self.bones[b as usize];
             let (q, t) = match body {
                 BodyId::Thigh => frames.thigh,
@@ -367,32 +405,104 @@ impl Tissue {
         }
     }
 
-    /// Elements squeezed below a tenth of their rest volume are pulled onto their own
-    /// goal shape (a rotated copy of the rest shape, never inverted).
-    fn guard_inversions(&mut self, contact: &Contact, gap: f32) {
-        for _ in 0..8 {
-            let bad: Vec<usize> = (0..self.fat.hexes.len())
-                .filter(|&e| {
-                    let h = self.fat.hexes[e];
-                    let p = h.map(|i| self.fat.x[i as usize].as_dvec3());
-                    let r = h.map(|i| self.fat.rest[i as usize].as_dvec3());
-                    hex_volume_points(&p) < 0.1 * hex_volume_points(&r)
-                })
-                .collect();
-            if bad.is_empty() {
-                return;
+    /// The validity guard (beyond the paper, which reports fat that breaks): where the
+    /// relaxed shape has an element below its allowed volume or body-surface triangles
+    /// behind the knee that cross, the vertices involved give back half of their way from
+    /// the fold (`safe`) to the relaxed shape, round after round, and after
+    /// [`GUARD_HALVINGS`] rounds take the fold outright. Elsewhere the relaxed shape
+    /// stands. After the first round only what the last round moved is looked at again.
+    /// Returns how many vertices it moved off the relaxed shape.
+    fn guard(&mut self, safe: &[Vec3]) -> usize {
+        let eps = self.config.min_volume_ratio;
+        let n_el = self.fat.hexes.len();
+        let volume = |x: &[Vec3], e: usize, hexes: &[[u32; 8]]| {
+            hex_volume_points(&hexes[e].map(|i| x[i as usize].as_dvec3()))
+        };
+        let floor = |e: usize, hexes: &[[u32; 8]], v0: &[f64]| {
+            0.5 * (eps * v0[e]).min(volume(safe, e, hexes)).max(0.0)
+        };
+        // Elements outside the relaxed region are rigid copies of the fold's (valid).
+        let mut bad_el: Vec<usize> = (0..n_el)
+            .filter(|&e| {
+                self.fat.active[e]
+                    && volume(&self.fat.x, e, &self.fat.hexes)
+                        <= floor(e, &self.fat.hexes, &self.fat.rest_volume)
+            })
+            .collect();
+        let relaxed = self.fat.x.clone();
+        let mut share = vec![1.0f32; relaxed.len()];
+        let mut bad = vec![false; relaxed.len()];
+        let mut moved_now = vec![false; relaxed.len()];
+        let mut moved_list: Vec<usize> = Vec::new();
+        for round in 0..GUARD_MAX_ROUNDS {
+            if round > 0 {
+                // Only elements touching a vertex just moved can have changed.
+                bad_el.clear();
+                for &v in &moved_list {
+                    bad_el.extend(self.fat.elements_of(v));
+                }
+                bad_el.sort_unstable();
+                bad_el.dedup();
+                bad_el.retain(|&e| {
+                    volume(&self.fat.x, e, &self.fat.hexes)
+                        <= floor(e, &self.fat.hexes, &self.fat.rest_volume)
+                });
             }
-            self.fat.compute_goals_for(&bad);
-            for &e in &bad {
-                let h = self.fat.hexes[e];
-                for (k, &v) in h.iter().enumerate() {
-                    if self.fat.free[v as usize] {
-                        self.fat.x[v as usize] = self.fat.goal(e, k);
+            for &e in &bad_el {
+                for &i in &self.fat.hexes[e] {
+                    bad[i as usize] = true;
+                }
+            }
+            if self.config.surface_guard {
+                // Triangles that kept the fold's rigid shape cannot cross each other; after
+                // the first round only those with a vertex just moved can have changed.
+                let live = if round == 0 {
+                    &self.fat.free
+                } else {
+                    &moved_now
+                };
+                let active: Vec<bool> = self
+                    .guard_triangles
+                    .iter()
+                    .map(|t| t.iter().any(|&i| live[i as usize]))
+                    .collect();
+                let pairs = intersect::crossing_pairs_among(
+                    &self.fat.x,
+                    &self.guard_triangles,
+                    Some(&active),
+                );
+                for (a, b) in pairs {
+                    let (ta, tb) = (
+                        self.guard_triangles[a as usize],
+                        self.guard_triangles[b as usize],
+                    );
+                    for i in ta.iter().chain(&tb) {
+                        bad[*i as usize] = true;
                     }
                 }
             }
-            self.apply_contact(contact, gap);
+            // Stop when nothing is wrong, or nothing is left to give back.
+            for &v in &moved_list {
+                moved_now[v] = false;
+            }
+            moved_list.clear();
+            for (i, b) in bad.iter_mut().enumerate() {
+                if std::mem::take(b) && share[i] > 0.0 {
+                    moved_now[i] = true;
+                    moved_list.push(i);
+                    share[i] = if round + 1 >= GUARD_HALVINGS {
+                        0.0
+                    } else {
+                        0.5 * share[i]
+                    };
+                    self.fat.x[i] = safe[i] + (relaxed[i] - safe[i]) * share[i];
+                }
+            }
+            if moved_list.is_empty() {
+                break;
+            }
         }
+        share.iter().filter(|&&s| s < 1.0).count()
     }
 
     /// Whether the tissue has an update due after `dt` more seconds.

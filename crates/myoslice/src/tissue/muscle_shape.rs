@@ -5,84 +5,21 @@
 
 use glam::{Quat, Vec3};
 
+use super::knee_fold::{Contact, KneeFold};
 use crate::lattice::{MuscleLattice, signed_volume};
-
-/// The smooth rotation field about the knee that tissue near the joint follows: a point at
-/// rest height `z` turns by `w(z)·θ` about the axis, `w` rising smoothly from 0 above the
-/// knee band to 1 below it.
-#[derive(Debug, Clone, Copy)]
-pub struct KneeField {
-    /// Axis point (rest).
-    pub point: Vec3,
-    /// Unit flexion axis.
-    pub axis: Vec3,
-    /// Knee angle (rad).
-    pub theta: f32,
-    /// Half-width of the band (m).
-    pub band: f32,
-}
-
-/// Contact behind the knee: the plane through the knee axis that bisects the knee angle.
-/// Tissue of the thigh keeps to its side, tissue of the calf to the other, so the back
-/// of the thigh and the calf press on each other there and never pass through.
-#[derive(Debug, Clone, Copy)]
-pub struct Contact {
-    /// Knee axis point (world).
-    pub point: Vec3,
-    /// Unit normal of the plane, toward the thigh.
-    pub normal: Vec3,
-    /// Distance (m) muscles keep from the plane.
-    pub muscle_margin: f32,
-}
-
-impl Contact {
-    /// The contact at knee angle `theta` (rad): the thigh's superior direction `up`
-    /// turned by half the angle about the flexion `axis`.
-    pub fn new(point: Vec3, axis: Vec3, up: Vec3, theta: f32, muscle_margin: f32) -> Self {
-        Self {
-            point,
-            normal: Quat::from_axis_angle(axis, 0.5 * theta) * up,
-            muscle_margin,
-        }
-    }
-
-    /// Where `p` goes; `thigh` says which side it belongs to, `margin` (m) how far from
-    /// the plane it stays.
-    pub fn apply(&self, p: Vec3, thigh: bool, margin: f32) -> Vec3 {
-        let s = if thigh { 1.0 } else { -1.0 };
-        let d = (p - self.point).dot(self.normal) * s;
-        if d < margin {
-            p + self.normal * (s * (margin - d))
-        } else {
-            p
-        }
-    }
-}
-
-impl KneeField {
-    /// Share of the shank's rotation at rest position `p`.
-    pub fn weight(&self, p: Vec3) -> f32 {
-        let t = ((self.point.z + self.band - p.z) / (2.0 * self.band)).clamp(0.0, 1.0);
-        t * t * (3.0 - 2.0 * t)
-    }
-
-    /// The field's rotation at rest position `p`.
-    pub fn rotation(&self, p: Vec3) -> Quat {
-        Quat::from_axis_angle(self.axis, self.theta * self.weight(p))
-    }
-
-    /// How much the field rules at `p`: 1 at the axis height, 0 beyond the band.
-    pub fn nearness(&self, p: Vec3) -> f32 {
-        (1.0 - (p.z - self.point.z).abs() / self.band).clamp(0.0, 1.0)
-    }
-}
 use crate::muscle::MuscleChain;
+
+/// Placement passes per update: each after the first corrects the cross-sections by the
+/// volume the previous one missed.
+const VOLUME_PASSES: usize = 5;
 
 /// Where a ring rides on the chain and how its vertices sit around it.
 #[derive(Debug, Clone)]
 pub struct MuscleShape {
     /// Chain positions at rest.
     rest_chain: Vec<Vec3>,
+    /// Whether each chain segment is belly (not tendon).
+    belly: Vec<bool>,
     /// Segment and fraction along it of each ring's centre.
     ring_param: Vec<(u32, f32)>,
     /// Ring index of each vertex.
@@ -100,9 +37,13 @@ pub struct MuscleShape {
     pub triangles: Vec<[u32; 3]>,
 }
 
-fn closest_on_polyline(p: &[Vec3], q: Vec3) -> (u32, f32) {
+/// Closest point to `q` on the segments of polyline `p` that `allowed` admits.
+fn closest_on_polyline(p: &[Vec3], allowed: &[bool], q: Vec3) -> (u32, f32) {
     let mut best = (0u32, 0.0f32, f32::INFINITY);
     for i in 0..p.len().saturating_sub(1) {
+        if !allowed[i] {
+            continue;
+        }
         let (a, b) = (p[i], p[i + 1]);
         let ab = b - a;
         let t = ((q - a).dot(ab) / ab.length_squared().max(1e-12)).clamp(0.0, 1.0);
@@ -118,6 +59,12 @@ impl MuscleShape {
     /// Binds a muscle lattice to its chain at rest.
     pub fn new(lattice: &MuscleLattice, chain: &MuscleChain) -> Self {
         let rest_chain = chain.x.clone();
+        // Rings ride on the belly: a ring past its end hangs on the last belly segment
+        // rather than on a tendon that turns with the other bone.
+        let mut belly: Vec<bool> = chain.tendon.iter().map(|t| !t).collect();
+        if !belly.iter().any(|b| *b) {
+            belly.iter_mut().for_each(|b| *b = true);
+        }
         let mesh = &lattice.mesh;
         let n = mesh.ring_len() as u32;
         let mut ring_of = vec![0u32; mesh.vertices.len()];
@@ -129,6 +76,7 @@ impl MuscleShape {
             ring_of[r.centre as usize] = ri as u32;
             ring_param.push(closest_on_polyline(
                 &rest_chain,
+                &belly,
                 mesh.vertices[r.centre as usize],
             ));
         }
@@ -145,6 +93,7 @@ impl MuscleShape {
         }
         Self {
             rest_chain,
+            belly,
             ring_param,
             ring_of,
             axial,
@@ -156,14 +105,13 @@ impl MuscleShape {
         }
     }
 
-    /// Places every vertex on the chain's current shape. Near the knee (within `band` m
-    /// of its axis) the rings turn with the same smooth field as the fat, a share
-    /// `w(z)` of the knee angle about the axis, instead of with the chain's bend: rings
-    /// on two sides of a sharp bend would otherwise cross.
+    /// Places every vertex on the chain's current shape. Where the knee fold rules (see
+    /// [`KneeFold::nearness`]) the rings turn with the same field as the fat, instead of
+    /// with the chain's bend: rings on two sides of a sharp bend would otherwise cross.
     ///
     /// `contact` keeps thigh-side and calf-side vertices apart behind the knee (see
     /// [`Contact`]); the cross-sections then make up the volume it squeezed out.
-    pub fn update(&mut self, chain: &MuscleChain, knee: &KneeField, contact: Option<&Contact>) {
+    pub fn update(&mut self, chain: &MuscleChain, knee: &KneeFold, contact: Option<&Contact>) {
         let segs = self.rest_chain.len() - 1;
         let mut seg_rot = Vec::with_capacity(segs);
         let mut seg_len = Vec::with_capacity(segs);
@@ -175,10 +123,14 @@ impl MuscleShape {
             seg_rot.push(Quat::from_rotation_arc(d0 / l0, d / l));
             seg_len.push((l / l0, d0 / l0));
         }
-        // Rotation and stretch at each chain point: the mean of its two segments.
+        // Rotation and stretch at each chain point: the mean of its two segments (of
+        // its belly segment alone where the other is tendon).
         let point = |i: usize| -> (Quat, f32) {
-            let a = i.saturating_sub(1).min(segs - 1);
-            let b = i.min(segs - 1);
+            let mut a = i.saturating_sub(1).min(segs - 1);
+            let mut b = i.min(segs - 1);
+            if self.belly[a] != self.belly[b] {
+                (a, b) = if self.belly[a] { (a, a) } else { (b, b) };
+            }
             (
                 seg_rot[a].slerp(seg_rot[b], 0.5),
                 0.5 * (seg_len[a].0 + seg_len[b].0),
@@ -203,7 +155,7 @@ impl MuscleShape {
             })
             .collect();
         let mut across_fix = 1.0f32;
-        for pass in 0..3 {
+        for pass in 0..VOLUME_PASSES {
             for (vi, p) in self.current.iter_mut().enumerate() {
                 let (c, q, axis_now, lambda) = rings[self.ring_of[vi] as usize];
                 let across = across_fix / lambda.sqrt();
@@ -214,7 +166,7 @@ impl MuscleShape {
                     *p = c.apply(*p, r.z >= knee.point.z, c.muscle_margin);
                 }
             }
-            if pass < 2 {
+            if pass + 1 < VOLUME_PASSES {
                 // What the piecewise map still gains or loses, the cross-sections give
                 // back: one factor per muscle, the square root of the volume ratio.
                 let v = self.volume();

@@ -23,6 +23,33 @@ pub fn extract_rotation(a: &Mat3, mut q: Quat, iters: usize) -> Quat {
     q
 }
 
+/// One warm-started iteration without trigonometry: the quaternion takes the first-order
+/// exponential of the rotation vector ω (exact to second order for the small corrections
+/// of a warm start; large ω are clamped to 0.5 rad so the normalisation stays well posed).
+/// Returns the new quaternion and its matrix.
+#[inline(always)]
+pub fn rotation_step(a: &Mat3, q: Quat) -> (Quat, Mat3) {
+    let r = Mat3::from_quat(q);
+    let num = r.x_axis.cross(a.x_axis) + r.y_axis.cross(a.y_axis) + r.z_axis.cross(a.z_axis);
+    let den =
+        (r.x_axis.dot(a.x_axis) + r.y_axis.dot(a.y_axis) + r.z_axis.dot(a.z_axis)).abs() + 1e-12;
+    let mut w = num / den;
+    let len2 = w.length_squared();
+    if len2 > 0.25 {
+        w *= 0.5 / len2.sqrt();
+    }
+    // q' = q + ½ (ω, 0) q
+    let dq = Quat::from_xyzw(w.x, w.y, w.z, 0.0) * q;
+    let q2 = Quat::from_xyzw(
+        q.x + 0.5 * dq.x,
+        q.y + 0.5 * dq.y,
+        q.z + 0.5 * dq.z,
+        q.w + 0.5 * dq.w,
+    )
+    .normalize();
+    (q2, Mat3::from_quat(q2))
+}
+
 /// The rotation of `a` from scratch (identity start, enough iterations to converge).
 pub fn polar_rotation(a: &Mat3) -> Quat {
     extract_rotation(a, Quat::IDENTITY, 64)

@@ -1,0 +1,191 @@
+//! `myoslice bench`: times the standard cases on this machine.
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::Result;
+use myoslice::prelude::*;
+use myoslice::tissue::FatSolver;
+use serde_json::json;
+
+struct Case {
+    name: &'static str,
+    seconds: f64,
+    per_unit_ns: Option<f64>,
+    unit: &'static str,
+    realtime_factor: Option<f64>,
+    note: String,
+}
+
+fn best_of<T>(n: usize, mut f: impl FnMut() -> Result<T>) -> Result<(f64, T)> {
+    let mut best = f64::INFINITY;
+    let mut out = None;
+    for _ in 0..n {
+        let t = Instant::now();
+        let r = f()?;
+        best = best.min(t.elapsed().as_secs_f64());
+        out = Some(r);
+    }
+    Ok((best, out.ok_or_else(|| anyhow::anyhow!("no run"))?))
+}
+
+fn fat_case(name: &'static str, dims: (usize, usize, usize), iters: usize) -> Result<Case> {
+    let mut s = FatSolver::grid(dims.0, dims.1, dims.2, 0.01);
+    // Bend it a little so the rotations are not trivial.
+    for p in &mut s.x {
+        p.z += 0.02 * (p.x * 10.0).sin();
+    }
+    let n = s.len();
+    let (t, _) = best_of(3, || {
+        for _ in 0..iters {
+            s.iterate(0.5);
+        }
+        Ok(())
+    })?;
+    Ok(Case {
+        name,
+        seconds: t,
+        per_unit_ns: Some(t * 1e9 / (iters * n) as f64),
+        unit: "ns per element-iteration",
+        realtime_factor: None,
+        note: format!(
+            "{n} hexahedra, {iters} iterations, {} threads",
+            rayon::current_num_threads()
+        ),
+    })
+}
+
+fn knee_case(name: &'static str, tissue: bool, muscles: &[&str], note: &str) -> Result<Case> {
+    let mut cfg = SimulationConfig::default();
+    cfg.tissue.enabled = tissue;
+    let base = Simulation::phantom(cfg)?;
+    let (t, angle) = best_of(3, || {
+        let mut s = base.clone();
+        for m in muscles {
+            s.set_excitation(m, 0.6)?;
+        }
+        s.step(1.0)?;
+        Ok(s.knee_angle().to_degrees())
+    })?;
+    Ok(Case {
+        name,
+        seconds: t,
+        per_unit_ns: Some(t * 1e9 / 1000.0),
+        unit: "ns per 1 ms step",
+        realtime_factor: Some(1.0 / t),
+        note: format!("{note}; knee reached {angle:.1}°"),
+    })
+}
+
+/// Runs every case and prints the table (or JSON).
+pub fn run(as_json: bool, vh: Option<&Path>) -> Result<()> {
+    let mut cases = Vec::new();
+    let (t, lat) = best_of(3, || {
+        let (v, tb) = Phantom::default().generate()?;
+        Ok(Lattice::build(&v, &tb, &BuildOptions::default())?)
+    })?;
+    cases.push(Case {
+        name: "build_phantom",
+        seconds: t,
+        per_unit_ns: None,
+        unit: "s",
+        realtime_factor: None,
+        note: format!("generate + build, {} fat hexahedra", lat.fat.hexes.len()),
+    });
+    if let Some(dir) = vh {
+        let (t, lat) = best_of(3, || {
+            let v = read_nifti(dir.join("vhf_left_leg_labels.nii.gz"))?;
+            let tb = LabelTable::from_path(dir.join("vhf_left_leg_labels.json"))?;
+            Ok(Lattice::build(&v, &tb, &BuildOptions::default())?)
+        })?;
+        cases.push(Case {
+            name: "build_visible_human",
+            seconds: t,
+            per_unit_ns: None,
+            unit: "s",
+            realtime_factor: None,
+            note: format!("read + build, {} fat hexahedra", lat.fat.hexes.len()),
+        });
+    }
+    const FLEXORS: [&str; 10] = [
+        "semitendinosus",
+        "semimembranosus",
+        "biceps_femoris_long",
+        "biceps_femoris_short",
+        "gracilis",
+        "sartorius",
+        "gastrocnemius_medial",
+        "gastrocnemius_lateral",
+        "popliteus",
+        "plantaris",
+    ];
+    cases.push(knee_case(
+        "knee_hinge_16",
+        false,
+        &FLEXORS,
+        "all muscles, the 10 flexors excited at 0.6, Hill, 1 ms, no tissue",
+    )?);
+    cases.push(fat_case("fat_kernel_840", (20, 7, 6), 2000)?);
+    cases.push(fat_case("fat_kernel_20k", (40, 25, 20), 100)?);
+    cases.push(fat_case("fat_kernel_200k", (100, 50, 40), 10)?);
+    cases.push(knee_case(
+        "whole_leg_step",
+        true,
+        &FLEXORS,
+        "all muscles, tissue at 30 Hz x 6 iterations, 1 ms",
+    )?);
+    let machine = machine();
+    let date = std::process::Command::new("date")
+        .arg("-u")
+        .arg("+%Y-%m-%d")
+        .output()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .unwrap_or_default();
+    if as_json {
+        let v = json!({
+            "machine": machine,
+            "date": date,
+            "threads": rayon::current_num_threads(),
+            "cases": cases.iter().map(|c| json!({
+                "name": c.name, "seconds": c.seconds, "per_unit_ns": c.per_unit_ns, "unit": c.unit,
+                "realtime_factor": c.realtime_factor, "note": c.note,
+            })).collect::<Vec<_>>(),
+        });
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        println!(
+            "{machine}, {} threads, {date}",
+            rayon::current_num_threads()
+        );
+        println!(
+            "{:<20} {:>10} {:>14} {:>10}  note",
+            "case", "seconds", "per unit", "x realtime"
+        );
+        for c in &cases {
+            println!(
+                "{:<20} {:>10.4} {:>14} {:>10}  {}",
+                c.name,
+                c.seconds,
+                c.per_unit_ns.map_or("-".into(), |v| format!("{v:.1} ns")),
+                c.realtime_factor.map_or("-".into(), |v| format!("{v:.1}")),
+                c.note
+            );
+        }
+    }
+    Ok(())
+}
+
+fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .map(|l| l.split(':').nth(1).unwrap_or("").trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    format!(
+        "{cpu}, {} logical cores",
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    )
+}

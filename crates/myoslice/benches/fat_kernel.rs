@@ -1,0 +1,44 @@
+//! The fat kernel (one shape-matching iteration) on blocks of 840, 20 000 and 200 000
+//! hexahedra, on one and two threads; throughput is in elements, so criterion's
+//! "elem/s" converts to ns per element-iteration (1e9 / throughput).
+
+mod common;
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use myoslice::tissue::FatSolver;
+
+fn bent(nx: usize, ny: usize, nz: usize) -> FatSolver {
+    let mut s = FatSolver::grid(nx, ny, nz, 0.01);
+    // A bend, so rotations and goals are not trivial.
+    for p in &mut s.x {
+        p.z += 0.02 * (p.x * 10.0).sin();
+    }
+    s
+}
+
+fn fat(c: &mut Criterion) {
+    for (name, dims) in [
+        ("840", (20, 7, 6)),
+        ("20k", (40, 25, 20)),
+        ("200k", (100, 50, 40)),
+    ] {
+        let mut g = c.benchmark_group(format!("fat_kernel_{name}"));
+        g.sample_size(20).measurement_time(Duration::from_secs(5));
+        let base = bent(dims.0, dims.1, dims.2);
+        g.throughput(Throughput::Elements(base.len() as u64));
+        for threads in [1, 2] {
+            let pool = common::pool(threads);
+            let mut s = base.clone();
+            g.bench_function(format!("{threads}_threads"), |b| {
+                b.iter(|| pool.install(|| s.iterate(black_box(0.5))))
+            });
+        }
+        g.finish();
+    }
+}
+
+criterion_group!(benches, fat);
+criterion_main!(benches);

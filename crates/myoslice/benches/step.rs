@@ -1,0 +1,80 @@
+//! Stepping: the muscle + skeleton step alone (Hill, 1 ms) and the whole leg with its
+//! tissue at the default rate. Each sample runs 0.1 s of simulated time from the same
+//! state, a flexion under way, so the real-time factor is 0.1 s over the time shown.
+
+mod common;
+
+use std::time::Duration;
+
+use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
+use myoslice::muscle::MuscleCatalogue;
+use myoslice::prelude::*;
+
+const SPAN_S: f64 = 0.1;
+
+fn flexing(lattice: Lattice, tissue: bool) -> Simulation {
+    let mut cfg = SimulationConfig::default();
+    cfg.tissue.enabled = tissue;
+    let mut sim = Simulation::new(lattice, cfg, &MuscleCatalogue::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    common::excite_flexors(&mut sim, 0.6);
+    // Into the motion: the knee is turning when the samples start.
+    sim.step(0.2).unwrap_or_else(|e| panic!("{e}"));
+    sim
+}
+
+fn bench_span(c: &mut Criterion, group: &str, name: &str, sim: &Simulation, threads: usize) {
+    let pool = common::pool(threads);
+    let mut g = c.benchmark_group(group);
+    g.sample_size(10).measurement_time(Duration::from_secs(10));
+    g.bench_function(format!("{name}_{threads}_threads"), |b| {
+        b.iter_batched(
+            || sim.clone(),
+            |mut s| pool.install(|| s.step(SPAN_S).map(|_| s)),
+            BatchSize::LargeInput,
+        )
+    });
+    g.finish();
+}
+
+fn steps(c: &mut Criterion) {
+    let phantom = common::phantom_lattice();
+    let vh = common::vh_lattice();
+    bench_span(
+        c,
+        "muscle_step_0.1s",
+        "phantom",
+        &flexing(phantom.clone(), false),
+        1,
+    );
+    if let Some(l) = &vh {
+        bench_span(
+            c,
+            "muscle_step_0.1s",
+            "visible_human",
+            &flexing(l.clone(), false),
+            1,
+        );
+    }
+    for threads in [1, 2] {
+        bench_span(
+            c,
+            "whole_leg_0.1s",
+            "phantom",
+            &flexing(phantom.clone(), true),
+            threads,
+        );
+        if let Some(l) = &vh {
+            bench_span(
+                c,
+                "whole_leg_0.1s",
+                "visible_human",
+                &flexing(l.clone(), true),
+                threads,
+            );
+        }
+    }
+}
+
+criterion_group!(benches, steps);
+criterion_main!(benches);

@@ -1,0 +1,159 @@
+//! The surfaces of a simulation now, per layer: what the viewer draws, Python reads and
+//! the exporters write.
+
+use std::str::FromStr;
+
+use glam::Vec3;
+
+use super::Simulation;
+use crate::body::body_of_bone;
+use crate::error::{Error, Result};
+use crate::lattice::FatLattice;
+
+/// A surface layer of the body.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Layer {
+    /// Every bone, moved with its body.
+    Bone,
+    /// Every muscle, deformed (or carried rigidly by its origin bone without tissue).
+    Muscle,
+    /// The body surface: the outer faces of the fat.
+    Skin,
+}
+
+impl Layer {
+    /// All layers, inside out.
+    pub const ALL: [Layer; 3] = [Layer::Bone, Layer::Muscle, Layer::Skin];
+
+    /// The layer's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Layer::Bone => "bone",
+            Layer::Muscle => "muscle",
+            Layer::Skin => "skin",
+        }
+    }
+}
+
+impl FromStr for Layer {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<Self> {
+        Layer::ALL
+            .into_iter()
+            .find(|l| l.name() == s)
+            .ok_or_else(|| Error::unknown_name("layer", s, Layer::ALL.iter().map(|l| l.name())))
+    }
+}
+
+/// Triangles over their own vertices (m, world).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Surface {
+    /// Vertices.
+    pub vertices: Vec<Vec3>,
+    /// Triangles, outward.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl Surface {
+    fn push(&mut self, vertices: &[Vec3], triangles: &[[u32; 3]]) {
+        let base = self.vertices.len() as u32;
+        self.vertices.extend_from_slice(vertices);
+        self.triangles
+            .extend(triangles.iter().map(|t| t.map(|i| i + base)));
+    }
+}
+
+impl FatLattice {
+    /// The body surface on its own vertices: for each skin vertex the fat vertex it is,
+    /// and the skin triangles over skin vertices.
+    pub fn skin_mesh(&self) -> (Vec<u32>, Vec<[u32; 3]>) {
+        let mut map = vec![u32::MAX; self.vertices.len()];
+        let mut used = Vec::new();
+        let triangles = self
+            .surface_triangles()
+            .iter()
+            .map(|t| {
+                t.map(|i| {
+                    let i = i as usize;
+                    if map[i] == u32::MAX {
+                        map[i] = used.len() as u32;
+                        used.push(i as u32);
+                    }
+                    map[i]
+                })
+            })
+            .collect();
+        (used, triangles)
+    }
+}
+
+impl Simulation {
+    /// Vertices of muscle `i` (simulation order) now: its deformed shape, or without
+    /// tissue its rest shape carried by its origin bone.
+    pub fn muscle_vertices(&self, i: usize) -> Vec<Vec3> {
+        match self.tissue() {
+            Some(t) => t.muscles[i].current.clone(),
+            None => {
+                let m = &self.muscles()[i];
+                let body = m.chain.origin.body;
+                self.lattice().muscles[m.lattice_index]
+                    .mesh
+                    .vertices
+                    .iter()
+                    .map(|p| self.frames().point(body, *p))
+                    .collect()
+            }
+        }
+    }
+
+    /// Fat vertices now (the rest shape without tissue).
+    pub fn fat_vertices(&self) -> &[Vec3] {
+        self.tissue()
+            .map_or(&self.lattice().fat.vertices[..], |t| t.fat_vertices())
+    }
+
+    /// One layer's surface now.
+    ///
+    /// ```no_run
+    /// use myoslice::prelude::*;
+    /// use myoslice::simulation::Layer;
+    /// let sim = Simulation::phantom(SimulationConfig::default())?;
+    /// let skin = sim.surface(Layer::Skin);
+    /// println!("{} skin triangles", skin.triangles.len());
+    /// # Ok::<(), myoslice::Error>(())
+    /// ```
+    pub fn surface(&self, layer: Layer) -> Surface {
+        let lat = self.lattice();
+        let mut s = Surface::default();
+        match layer {
+            Layer::Bone => {
+                for b in &lat.bones {
+                    let body = body_of_bone(&b.name);
+                    let v: Vec<Vec3> = b
+                        .mesh
+                        .vertices
+                        .iter()
+                        .map(|p| self.frames().point(body, *p))
+                        .collect();
+                    s.push(&v, &b.mesh.triangles);
+                }
+            }
+            Layer::Muscle => {
+                for (i, m) in self.muscles().iter().enumerate() {
+                    s.push(
+                        &self.muscle_vertices(i),
+                        &lat.muscles[m.lattice_index].mesh.triangles,
+                    );
+                }
+            }
+            Layer::Skin => {
+                let (used, triangles) = lat.fat.skin_mesh();
+                let x = self.fat_vertices();
+                s.vertices = used.iter().map(|&i| x[i as usize]).collect();
+                s.triangles = triangles;
+            }
+        }
+        s
+    }
+}

@@ -1,0 +1,185 @@
+"""Type stubs of the compiled module ``myoslice._myoslice`` (hand-written; checked with
+``python -m mypy.stubtest myoslice._myoslice``).
+
+Units are SI throughout: metres, seconds, newtons, radians. Every array property returns
+a fresh copy: writing to it does not change the simulation.
+"""
+
+import os
+from typing import TypeAlias, final
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ["Simulation", "State", "__version__"]
+
+_StrPath: TypeAlias = str | os.PathLike[str]
+
+__version__: str
+
+@final
+class State:
+    """An opaque checkpoint of a :class:`Simulation` (``Simulation.state()``)."""
+
+    @property
+    def time(self) -> float:
+        """Simulated time of the checkpoint (s)."""
+
+    def __repr__(self) -> str: ...
+
+@final
+class Simulation:
+    """A muscle-driven lower limb. Build it with :meth:`phantom`, :meth:`from_nifti` or
+    :meth:`from_scenario`; excite its muscles, :meth:`step` it, and read the knee, the
+    muscles and the deformed tissue as numpy arrays."""
+
+    @staticmethod
+    def phantom(
+        *,
+        body_mass_kg: float = 60.0,
+        height_m: float = 1.65,
+        muscle_model: str = "hill",
+        tissue: bool = True,
+        tissue_rate_hz: float = 30.0,
+        initial_knee_deg: float = 0.0,
+        max_step_s: float = 0.001,
+        voxel_mm: float | None = None,
+    ) -> Simulation:
+        """The built-in lower-limb phantom (no files needed).
+
+        ``muscle_model`` is ``"hill"`` or ``"spring"``; ``tissue=False`` skips the
+        deformable fat and muscle volumes (faster; the tissue arrays are then empty).
+        """
+
+    @staticmethod
+    def from_nifti(
+        volume: _StrPath,
+        labels: _StrPath,
+        *,
+        slice_step: int = 5,
+        rays: int = 48,
+        body_mass_kg: float = 60.0,
+        height_m: float = 1.65,
+        muscle_model: str = "hill",
+        tissue: bool = True,
+        tissue_rate_hz: float = 30.0,
+        initial_knee_deg: float = 0.0,
+        max_step_s: float = 0.001,
+    ) -> Simulation:
+        """A model from a NIfTI label volume and its label table (JSON or TOML)."""
+
+    @staticmethod
+    def from_scenario(path: _StrPath) -> Simulation:
+        """A model from a scenario file (TOML)."""
+
+    def step(self, dt: float = 0.001, n: int = 1) -> None:
+        """Advances ``n`` steps of ``dt`` seconds (the GIL is released meanwhile)."""
+
+    def set_excitation(self, name: str, value: float) -> None:
+        """Sets one muscle's excitation in [0, 1]."""
+
+    def set_excitations(self, values: dict[str, float] | npt.ArrayLike) -> None:
+        """Sets excitations from a dict ``{name: value}`` or an array of shape
+        ``(n_muscles,)`` in :attr:`muscle_names` order."""
+
+    @property
+    def excitations(self) -> npt.NDArray[np.float64]:
+        """Excitation of every muscle, float64 ``(n_muscles,)``."""
+
+    @property
+    def muscle_names(self) -> list[str]:
+        """Muscle names, in the order of every per-muscle array."""
+
+    @property
+    def muscle_groups(self) -> list[str]:
+        """Control group of each muscle: ``"flexor"``, ``"extensor"`` or ``"other"``."""
+
+    @property
+    def time(self) -> float:
+        """Simulated time (s)."""
+
+    @property
+    def knee_angle(self) -> float:
+        """Knee flexion angle (rad)."""
+
+    @property
+    def knee_velocity(self) -> float:
+        """Knee flexion velocity (rad/s)."""
+
+    @property
+    def knee_torque(self) -> float:
+        """Net muscle torque about the knee (N m, positive flexing)."""
+
+    @property
+    def knee_limits(self) -> tuple[float, float]:
+        """Flexion limits (rad)."""
+
+    @property
+    def activations(self) -> npt.NDArray[np.float64]:
+        """Activation of every muscle, float64 ``(n_muscles,)``."""
+
+    @property
+    def forces(self) -> npt.NDArray[np.float64]:
+        """Tendon force of every muscle (N), float64 ``(n_muscles,)``."""
+
+    @property
+    def fibre_lengths(self) -> npt.NDArray[np.float64]:
+        """Fibre length of every muscle (m), float64 ``(n_muscles,)``."""
+
+    @property
+    def moment_arms(self) -> npt.NDArray[np.float64]:
+        """Moment arm of every muscle about the knee (m, positive flexing)."""
+
+    def surface(self, layer: str) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint32]]:
+        """Vertices (float32 ``(N, 3)``, m) and triangles (uint32 ``(M, 3)``) of a layer
+        now: ``"bone"``, ``"muscle"`` or ``"skin"``."""
+
+    @property
+    def area_change(self) -> npt.NDArray[np.float32]:
+        """A/A0 - 1 of each fat element's outer face (0 inside), float32
+        ``(n_fat_elements,)``; shape ``(0,)`` without tissue."""
+
+    @property
+    def deformation_degree(self) -> npt.NDArray[np.float32]:
+        """Deformation degree of each fat element (m), float32 ``(n_fat_elements,)``;
+        shape ``(0,)`` without tissue."""
+
+    @property
+    def volume_ratio(self) -> npt.NDArray[np.float32]:
+        """Volume over rest volume of each fat element, float32 ``(n_fat_elements,)``;
+        shape ``(0,)`` without tissue."""
+
+    @property
+    def muscle_volume_ratio(self) -> npt.NDArray[np.float32]:
+        """Volume over rest volume of each muscle, float32 ``(n_muscles,)``; shape
+        ``(0,)`` without tissue."""
+
+    @property
+    def n_fat_elements(self) -> int:
+        """Number of fat elements (hexahedra)."""
+
+    def set_knee(self, angle: float, velocity: float = 0.0) -> None:
+        """Puts the knee at ``angle`` (rad) with flexion ``velocity`` (rad/s)."""
+
+    def state(self) -> State:
+        """A checkpoint of the whole dynamic state."""
+
+    def set_state(self, state: State) -> None:
+        """Restores a checkpoint taken from this simulation."""
+
+    def render(
+        self,
+        width: int = 640,
+        height: int = 480,
+        *,
+        color: str = "area",
+        camera: str = "oblique",
+    ) -> npt.NDArray[np.uint8]:
+        """Renders the leg off-screen: uint8 ``(height, width, 3)``.
+
+        ``color``: ``"area"``, ``"degree"`` or ``"none"``; ``camera``: ``"front"``,
+        ``"side"``, ``"back"``, ``"medial"`` or ``"oblique"``. Raises
+        :class:`~myoslice.errors.RendererUnavailableError` when no GPU adapter exists.
+        """
+
+    def __repr__(self) -> str: ...

@@ -1,0 +1,640 @@
+//! Python bindings of myoslice: `myoslice._myoslice`. Thin: every behaviour lives in the
+//! core crate; this file converts arguments, arrays and errors.
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+use glam::Vec3;
+use myoslice::muscle::MuscleCatalogue;
+use myoslice::prelude::*;
+use myoslice::simulation::{Layer, SimulationState};
+use myoslice_viewer::capture::{CaptureOptions, Offscreen};
+use myoslice_viewer::{CameraPreset, ColorMode, Gpu};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyDict, PyType};
+
+/// Vertices (float32, (N, 3)) and triangles (uint32, (M, 3)) of a surface.
+type SurfaceArrays<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<u32>>);
+
+/// The Python exception classes of `myoslice.errors`.
+#[derive(Clone, Copy)]
+enum Kind {
+    Invalid,
+    UnknownName,
+    File,
+    Simulation,
+    Renderer,
+}
+
+fn py_err(py: Python<'_>, kind: Kind, msg: String) -> PyErr {
+    static CLASSES: [PyOnceLock<Py<PyType>>; 5] = [
+        PyOnceLock::new(),
+        PyOnceLock::new(),
+        PyOnceLock::new(),
+        PyOnceLock::new(),
+        PyOnceLock::new(),
+    ];
+    let (i, name) = match kind {
+        Kind::Invalid => (0, "InvalidInputError"),
+        Kind::UnknownName => (1, "UnknownNameError"),
+        Kind::File => (2, "ModelFileError"),
+        Kind::Simulation => (3, "SimulationError"),
+        Kind::Renderer => (4, "RendererUnavailableError"),
+    };
+    match CLASSES[i].import(py, "myoslice.errors", name) {
+        Ok(ty) => PyErr::from_type(ty.clone(), msg),
+        Err(e) => e,
+    }
+}
+
+fn core_err(py: Python<'_>, e: myoslice::Error) -> PyErr {
+    use myoslice::Error as E;
+    let kind = match &e {
+        E::Io { .. }
+        | E::Write { .. }
+        | E::Nifti { .. }
+        | E::Png { .. }
+        | E::Parse { .. }
+        | E::UnknownLabel { .. } => Kind::File,
+        E::UnknownName { .. } => Kind::UnknownName,
+        E::NonFinite { .. } => Kind::Simulation,
+        _ => Kind::Invalid,
+    };
+    py_err(py, kind, e.to_string())
+}
+
+trait OrPy<T> {
+    fn or_py(self, py: Python<'_>) -> PyResult<T>;
+}
+
+impl<T> OrPy<T> for Result<T, myoslice::Error> {
+    fn or_py(self, py: Python<'_>) -> PyResult<T> {
+        self.map_err(|e| core_err(py, e))
+    }
+}
+
+/// A checkpoint of a simulation (`Simulation.state()` / `set_state()`).
+#[pyclass(name = "State", module = "myoslice._myoslice", frozen)]
+struct PyState {
+    inner: SimulationState,
+}
+
+#[pymethods]
+impl PyState {
+    /// Simulated time of the checkpoint (s).
+    #[getter]
+    fn time(&self) -> f64 {
+        self.inner.time()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("State(time={:.6})", self.inner.time())
+    }
+}
+
+/// A muscle-driven lower limb: step it, excite its muscles, read the knee, the muscles and
+/// the deformed tissue as numpy arrays.
+#[pyclass(name = "Simulation", module = "myoslice._myoslice")]
+struct PySimulation {
+    sim: Simulation,
+    offscreen: Option<(u32, u32, Offscreen)>,
+}
+
+#[allow(clippy::too_many_arguments)]
+fn config(
+    py: Python<'_>,
+    body_mass_kg: f64,
+    height_m: f64,
+    muscle_model: &str,
+    tissue: bool,
+    tissue_rate_hz: f64,
+    initial_knee_deg: f64,
+    max_step_s: f64,
+) -> PyResult<SimulationConfig> {
+    let model = match muscle_model {
+        "hill" => MuscleModel::Hill,
+        "spring" => MuscleModel::Spring,
+        other => {
+            return Err(py_err(
+                py,
+                Kind::Invalid,
+                format!("muscle_model = '{other}': expected 'hill' or 'spring'"),
+            ));
+        }
+    };
+    let mut c = SimulationConfig {
+        body_mass_kg,
+        height_m,
+        muscle_model: model,
+        initial_knee_deg,
+        max_step_s,
+        ..SimulationConfig::default()
+    };
+    c.tissue.enabled = tissue;
+    c.tissue.rate_hz = tissue_rate_hz;
+    c.validate().or_py(py)?;
+    Ok(c)
+}
+
+fn check_path(py: Python<'_>, p: &Path, what: &str) -> PyResult<()> {
+    if p.exists() {
+        Ok(())
+    } else {
+        Err(py_err(
+            py,
+            Kind::File,
+            format!("{what} {} does not exist", p.display()),
+        ))
+    }
+}
+
+fn vec3_array<'py>(py: Python<'py>, v: &[Vec3]) -> Bound<'py, PyArray2<f32>> {
+    let flat: Vec<f32> = v.iter().flat_map(|p| p.to_array()).collect();
+    Array2::from_shape_vec((v.len(), 3), flat).map_or_else(
+        |_| PyArray2::zeros(py, (0, 3), false),
+        |a| a.into_pyarray(py),
+    )
+}
+
+fn tri_array<'py>(py: Python<'py>, t: &[[u32; 3]]) -> Bound<'py, PyArray2<u32>> {
+    let flat: Vec<u32> = t.iter().flatten().copied().collect();
+    Array2::from_shape_vec((t.len(), 3), flat).map_or_else(
+        |_| PyArray2::zeros(py, (0, 3), false),
+        |a| a.into_pyarray(py),
+    )
+}
+
+fn gpu(py: Python<'_>) -> PyResult<&'static Gpu> {
+    static GPU: OnceLock<Result<Gpu, String>> = OnceLock::new();
+    GPU.get_or_init(|| Gpu::headless().map_err(|e| e.to_string()))
+        .as_ref()
+        .map_err(|e| {
+            py_err(
+                py,
+                Kind::Renderer,
+                format!("the off-screen renderer is not available: {e}"),
+            )
+        })
+}
+
+#[pymethods]
+impl PySimulation {
+    /// The built-in lower-limb phantom (no files needed). Units are SI.
+    #[staticmethod]
+    #[pyo3(signature = (*, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tissue = true, tissue_rate_hz = 30.0, initial_knee_deg = 0.0, max_step_s = 0.001, voxel_mm = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn phantom(
+        py: Python<'_>,
+        body_mass_kg: f64,
+        height_m: f64,
+        muscle_model: &str,
+        tissue: bool,
+        tissue_rate_hz: f64,
+        initial_knee_deg: f64,
+        max_step_s: f64,
+        voxel_mm: Option<f64>,
+    ) -> PyResult<Self> {
+        let c = config(
+            py,
+            body_mass_kg,
+            height_m,
+            muscle_model,
+            tissue,
+            tissue_rate_hz,
+            initial_knee_deg,
+            max_step_s,
+        )?;
+        let sim = py
+            .detach(move || -> myoslice::Result<Simulation> {
+                let (v, t) = Phantom { voxel_mm }.generate()?;
+                let lat = Lattice::build(&v, &t, &BuildOptions::default())?;
+                Simulation::new(lat, c, &MuscleCatalogue::default())
+            })
+            .or_py(py)?;
+        Ok(Self {
+            sim,
+            offscreen: None,
+        })
+    }
+
+    /// A NIfTI label volume with its label table (JSON or TOML).
+    #[staticmethod]
+    #[pyo3(signature = (volume, labels, *, slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tissue = true, tissue_rate_hz = 30.0, initial_knee_deg = 0.0, max_step_s = 0.001))]
+    #[allow(clippy::too_many_arguments)]
+    fn from_nifti(
+        py: Python<'_>,
+        volume: PathBuf,
+        labels: PathBuf,
+        slice_step: usize,
+        rays: usize,
+        body_mass_kg: f64,
+        height_m: f64,
+        muscle_model: &str,
+        tissue: bool,
+        tissue_rate_hz: f64,
+        initial_knee_deg: f64,
+        max_step_s: f64,
+    ) -> PyResult<Self> {
+        check_path(py, &volume, "volume")?;
+        check_path(py, &labels, "label table")?;
+        let c = config(
+            py,
+            body_mass_kg,
+            height_m,
+            muscle_model,
+            tissue,
+            tissue_rate_hz,
+            initial_knee_deg,
+            max_step_s,
+        )?;
+        let build = BuildOptions {
+            reduction: SliceReduction {
+                slice_step,
+                pixel_mm: None,
+            },
+            rays,
+            ..BuildOptions::default()
+        };
+        let sim = py
+            .detach(move || Simulation::from_nifti(volume, labels, &build, c))
+            .or_py(py)?;
+        Ok(Self {
+            sim,
+            offscreen: None,
+        })
+    }
+
+    /// A scenario file (TOML): model, body, muscle model, excitation schedules.
+    #[staticmethod]
+    fn from_scenario(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        check_path(py, &path, "scenario")?;
+        let sim = py
+            .detach(move || Scenario::from_path(&path)?.build())
+            .or_py(py)?;
+        Ok(Self {
+            sim,
+            offscreen: None,
+        })
+    }
+
+    /// Advances `n` steps of `dt` seconds (the GIL is released meanwhile).
+    #[pyo3(signature = (dt = 0.001, n = 1))]
+    fn step(&mut self, py: Python<'_>, dt: f64, n: i64) -> PyResult<()> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(py_err(
+                py,
+                Kind::Invalid,
+                format!("dt = {dt}: expected a finite step > 0 s"),
+            ));
+        }
+        if n < 1 {
+            return Err(py_err(
+                py,
+                Kind::Invalid,
+                format!("n = {n}: expected at least one step"),
+            ));
+        }
+        let sim = &mut self.sim;
+        py.detach(move || -> myoslice::Result<()> {
+            for _ in 0..n {
+                sim.step(dt)?;
+            }
+            Ok(())
+        })
+        .or_py(py)
+    }
+
+    /// Sets one muscle's excitation in [0, 1].
+    fn set_excitation(&mut self, py: Python<'_>, name: &str, value: f64) -> PyResult<()> {
+        self.sim.set_excitation(name, value).or_py(py)
+    }
+
+    /// Sets excitations from a dict {name: value} or an array in `muscle_names` order.
+    fn set_excitations(&mut self, py: Python<'_>, values: &Bound<'_, PyAny>) -> PyResult<()> {
+        if let Ok(d) = values.cast::<PyDict>() {
+            let mut pairs = Vec::with_capacity(d.len());
+            for (k, v) in d.iter() {
+                let name: String = k.extract().map_err(|_| {
+                    py_err(
+                        py,
+                        Kind::Invalid,
+                        "excitation keys must be muscle names (str)".into(),
+                    )
+                })?;
+                let value: f64 = v.extract().map_err(|_| {
+                    py_err(
+                        py,
+                        Kind::Invalid,
+                        format!("excitation of {name} must be a number"),
+                    )
+                })?;
+                self.sim.muscle_index(&name).or_py(py)?;
+                pairs.push((name, value));
+            }
+            for (name, value) in &pairs {
+                if !(value.is_finite() && (0.0..=1.0).contains(value)) {
+                    return Err(py_err(
+                        py,
+                        Kind::Invalid,
+                        format!("excitation of {name} = {value}: expected a value in [0, 1]"),
+                    ));
+                }
+            }
+            for (name, value) in pairs {
+                self.sim.set_excitation(&name, value).or_py(py)?;
+            }
+            return Ok(());
+        }
+        let arr: PyReadonlyArray1<'_, f64> = match values.extract::<PyReadonlyArray1<'_, f64>>() {
+            Ok(a) => a,
+            Err(_) => {
+                let np = py.import("numpy")?;
+                let conv = np.call_method1("asarray", (values, "float64"));
+                let conv = conv.map_err(|_| {
+                    py_err(
+                        py,
+                        Kind::Invalid,
+                        "excitations must be a dict or a 1-D array of numbers".into(),
+                    )
+                })?;
+                if conv.getattr("ndim")?.extract::<usize>()? != 1 {
+                    return Err(py_err(
+                        py,
+                        Kind::Invalid,
+                        format!(
+                            "excitations array must be 1-D with {} values",
+                            self.sim.muscles().len()
+                        ),
+                    ));
+                }
+                conv.extract().map_err(|_| {
+                    py_err(
+                        py,
+                        Kind::Invalid,
+                        "excitations must be a 1-D float array".into(),
+                    )
+                })?
+            }
+        };
+        let v = arr.as_array().to_vec();
+        self.sim.set_excitations(&v).or_py(py)
+    }
+
+    /// Excitation of every muscle (copy).
+    #[getter]
+    fn excitations<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.sim.excitations())
+    }
+
+    /// Muscle names, in the order of every per-muscle array.
+    #[getter]
+    fn muscle_names(&self) -> Vec<String> {
+        self.sim
+            .muscle_names()
+            .iter()
+            .map(|s| s.to_string())
+            .collect()
+    }
+
+    /// Control group of each muscle: "flexor", "extensor" or "other".
+    #[getter]
+    fn muscle_groups(&self) -> Vec<String> {
+        self.sim
+            .muscles()
+            .iter()
+            .map(|m| m.group.as_str().to_string())
+            .collect()
+    }
+
+    /// Simulated time (s).
+    #[getter]
+    fn time(&self) -> f64 {
+        self.sim.time()
+    }
+
+    /// Knee flexion angle (rad).
+    #[getter]
+    fn knee_angle(&self) -> f64 {
+        self.sim.knee_angle()
+    }
+
+    /// Knee flexion velocity (rad/s).
+    #[getter]
+    fn knee_velocity(&self) -> f64 {
+        self.sim.knee_velocity()
+    }
+
+    /// Net muscle torque about the knee (N m, positive flexing).
+    #[getter]
+    fn knee_torque(&self) -> f64 {
+        self.sim.knee_torque()
+    }
+
+    /// Flexion limits (rad).
+    #[getter]
+    fn knee_limits(&self) -> (f64, f64) {
+        let [a, b] = self.sim.skeleton().limits();
+        (a, b)
+    }
+
+    /// Activation of every muscle.
+    #[getter]
+    fn activations<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(
+            py,
+            self.sim.muscles().iter().map(|m| m.activation).collect(),
+        )
+    }
+
+    /// Tendon force of every muscle (N).
+    #[getter]
+    fn forces<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(py, self.sim.muscles().iter().map(|m| m.force).collect())
+    }
+
+    /// Fibre length of every muscle (m).
+    #[getter]
+    fn fibre_lengths<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(
+            py,
+            self.sim.muscles().iter().map(|m| m.fibre.length).collect(),
+        )
+    }
+
+    /// Moment arm of every muscle about the knee (m, positive flexing).
+    #[getter]
+    fn moment_arms<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        PyArray1::from_vec(
+            py,
+            self.sim.muscles().iter().map(|m| m.moment_arm).collect(),
+        )
+    }
+
+    /// Vertices (float32, (N, 3), m) and triangles (uint32, (M, 3)) of a layer now:
+    /// "bone", "muscle" or "skin".
+    fn surface<'py>(&self, py: Python<'py>, layer: &str) -> PyResult<SurfaceArrays<'py>> {
+        let layer: Layer = layer.parse().or_py(py)?;
+        let surface = self.sim.surface(layer);
+        Ok((
+            vec3_array(py, &surface.vertices),
+            tri_array(py, &surface.triangles),
+        ))
+    }
+
+    /// Area change A/A0 − 1 of each fat element's outer face (float32; empty without tissue).
+    #[getter]
+    fn area_change<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f32>> {
+        PyArray1::from_vec(
+            py,
+            self.sim
+                .tissue_metrics()
+                .map_or_else(Vec::new, |m| m.area_change.clone()),
+        )
+    }
+
+    /// Deformation degree (paper Eq. 5, m) of each fat element (float32; empty without tissue).
+    #[getter]
+    fn deformation_degree<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f32>> {
+        PyArray1::from_vec(
+            py,
+            self.sim
+                .tissue_metrics()
+                .map_or_else(Vec::new, |m| m.deformation_degree.clone()),
+        )
+    }
+
+    /// Volume over rest volume of each fat element (float32; empty without tissue).
+    #[getter]
+    fn volume_ratio<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f32>> {
+        PyArray1::from_vec(
+            py,
+            self.sim
+                .tissue_metrics()
+                .map_or_else(Vec::new, |m| m.volume_ratio.clone()),
+        )
+    }
+
+    /// Volume over rest volume of each muscle (float32; empty without tissue).
+    #[getter]
+    fn muscle_volume_ratio<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f32>> {
+        PyArray1::from_vec(
+            py,
+            self.sim
+                .tissue_metrics()
+                .map_or_else(Vec::new, |m| m.muscle_volume_ratio.clone()),
+        )
+    }
+
+    /// Number of fat elements (hexahedra).
+    #[getter]
+    fn n_fat_elements(&self) -> usize {
+        self.sim.lattice().fat.hexes.len()
+    }
+
+    /// Puts the knee at `angle` (rad) with flexion `velocity` (rad/s).
+    #[pyo3(signature = (angle, velocity = 0.0))]
+    fn set_knee(&mut self, py: Python<'_>, angle: f64, velocity: f64) -> PyResult<()> {
+        self.sim.set_knee(angle, velocity).or_py(py)
+    }
+
+    /// A checkpoint of the whole dynamic state.
+    fn state(&self) -> PyState {
+        PyState {
+            inner: self.sim.state(),
+        }
+    }
+
+    /// Restores a checkpoint of this simulation.
+    fn set_state(&mut self, py: Python<'_>, state: &PyState) -> PyResult<()> {
+        self.sim.set_state(&state.inner).or_py(py)
+    }
+
+    /// Renders the leg off-screen: uint8 (height, width, 3).
+    #[pyo3(signature = (width = 640, height = 480, *, color = "area", camera = "oblique"))]
+    fn render<'py>(
+        &mut self,
+        py: Python<'py>,
+        width: u32,
+        height: u32,
+        color: &str,
+        camera: &str,
+    ) -> PyResult<Bound<'py, PyArray3<u8>>> {
+        let color_mode = ColorMode::parse(color).ok_or_else(|| {
+            py_err(
+                py,
+                Kind::Invalid,
+                format!("color = '{color}': expected 'area', 'degree' or 'none'"),
+            )
+        })?;
+        let cam = CameraPreset::parse(camera).ok_or_else(|| {
+            py_err(
+                py,
+                Kind::Invalid,
+                format!("camera = '{camera}': expected front, side, back, medial or oblique"),
+            )
+        })?;
+        if !(16..=8192).contains(&width) || !(16..=8192).contains(&height) {
+            return Err(py_err(
+                py,
+                Kind::Invalid,
+                format!("render size {width}x{height}: expected 16 to 8192 pixels each way"),
+            ));
+        }
+        let gpu = gpu(py)?;
+        let mut opts = CaptureOptions {
+            width,
+            height,
+            camera: cam,
+            legend: false,
+            ..CaptureOptions::default()
+        };
+        opts.scene.color_mode = color_mode;
+        if self
+            .offscreen
+            .as_ref()
+            .is_none_or(|(w, h, _)| (*w, *h) != (width, height))
+        {
+            self.offscreen = Some((width, height, Offscreen::new(gpu, width, height)));
+        }
+        let Some((_, _, off)) = self.offscreen.as_mut() else {
+            unreachable!()
+        };
+        let sim = &self.sim;
+        let rgba = py
+            .detach(|| off.render(gpu, sim, &opts).map_err(|e| e.to_string()))
+            .map_err(|e| py_err(py, Kind::Renderer, e))?;
+        let rgb: Vec<u8> = rgba
+            .chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect();
+        let arr = numpy::ndarray::Array3::from_shape_vec((height as usize, width as usize, 3), rgb)
+            .map_err(|e| py_err(py, Kind::Renderer, e.to_string()))?;
+        Ok(arr.into_pyarray(py))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Simulation(t={:.4} s, knee={:.1} deg, {} muscles, {} fat elements)",
+            self.sim.time(),
+            self.sim.knee_angle().to_degrees(),
+            self.sim.muscles().len(),
+            self.sim.lattice().fat.hexes.len()
+        )
+    }
+}
+
+/// The compiled core of the `myoslice` package.
+#[pymodule]
+mod _myoslice {
+    #[pymodule_export]
+    use super::{PySimulation, PyState};
+
+    #[pymodule_init]
+    fn init(m: &pyo3::Bound<'_, pyo3::types::PyModule>) -> pyo3::PyResult<()> {
+        use pyo3::types::PyModuleMethods;
+        m.add("__version__", env!("CARGO_PKG_VERSION"))
+    }
+}

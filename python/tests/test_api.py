@@ -1,0 +1,336 @@
+"""The compiled module's API: types, shapes and dtypes of everything in the contract,
+stepping, excitations, determinism and checkpoints."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import myoslice
+from myoslice import Simulation, State
+
+HAMSTRINGS = ("semitendinosus", "semimembranosus", "biceps_femoris_long", "biceps_femoris_short")
+PER_MUSCLE_F64 = ("excitations", "activations", "forces", "fibre_lengths", "moment_arms")
+PER_FAT_F32 = ("area_change", "deformation_degree", "volume_ratio")
+LAYERS = ("bone", "muscle", "skin")
+
+
+def flex(sim: Simulation, seconds: float = 0.5) -> None:
+    """Fully excites the hamstrings for ``seconds``."""
+    sim.set_excitations(dict.fromkeys(HAMSTRINGS, 1.0))
+    sim.step(0.001, n=round(seconds / 0.001))
+
+
+def snapshot(sim: Simulation) -> dict[str, object]:
+    """Every observable of a simulation, for exact comparisons."""
+    out: dict[str, object] = {
+        name: getattr(sim, name)
+        for name in (
+            "time",
+            "knee_angle",
+            "knee_velocity",
+            "knee_torque",
+            *PER_MUSCLE_F64,
+            *PER_FAT_F32,
+            "muscle_volume_ratio",
+        )
+    }
+    for layer in LAYERS:
+        out[f"surface_{layer}"] = sim.surface(layer)[0]
+    return out
+
+
+def assert_identical(a: dict[str, object], b: dict[str, object]) -> None:
+    assert a.keys() == b.keys()
+    for key in a:
+        x, y = a[key], b[key]
+        if isinstance(x, np.ndarray):
+            assert isinstance(y, np.ndarray)
+            assert x.dtype == y.dtype, key
+            assert np.array_equal(x, y), f"{key} differs"
+        else:
+            assert type(x) is float and type(y) is float, key
+            assert x == y, f"{key}: {x!r} != {y!r}"
+
+
+# --- module and construction ---------------------------------------------------------
+
+
+def test_version_is_a_string() -> None:
+    assert isinstance(myoslice.__version__, str) and myoslice.__version__
+
+
+def test_public_names() -> None:
+    for name in myoslice.__all__:
+        assert hasattr(myoslice, name), name
+
+
+def test_simulation_has_no_plain_constructor() -> None:
+    with pytest.raises(TypeError):
+        Simulation()
+
+
+def test_repr(rigid: Simulation) -> None:
+    assert "Simulation" in repr(rigid)
+    assert "State" in repr(rigid.state())
+
+
+# --- names, groups and per-muscle arrays ---------------------------------------------
+
+
+def test_muscle_names_and_groups(rigid: Simulation) -> None:
+    names, groups = rigid.muscle_names, rigid.muscle_groups
+    assert isinstance(names, list) and all(isinstance(n, str) for n in names)
+    assert len(set(names)) == len(names) > 0
+    assert isinstance(groups, list) and len(groups) == len(names)
+    assert set(groups) <= {"flexor", "extensor", "other"}
+    assert {"flexor", "extensor"} <= set(groups)
+    for h in HAMSTRINGS:
+        assert h in names
+        assert groups[names.index(h)] == "flexor"
+
+
+@pytest.mark.parametrize("name", PER_MUSCLE_F64)
+def test_per_muscle_arrays(rigid: Simulation, name: str) -> None:
+    flex(rigid, 0.05)
+    a = getattr(rigid, name)
+    assert isinstance(a, np.ndarray)
+    assert a.dtype == np.float64
+    assert a.shape == (len(rigid.muscle_names),)
+    assert np.all(np.isfinite(a))
+
+
+@pytest.mark.parametrize("name", PER_MUSCLE_F64)
+def test_arrays_are_fresh_copies(rigid: Simulation, name: str) -> None:
+    a = getattr(rigid, name)
+    b = getattr(rigid, name)
+    assert not np.shares_memory(a, b)
+    before = a.copy()
+    if a.flags.writeable:
+        a[:] = 0.5
+        assert np.array_equal(getattr(rigid, name), before)
+
+
+def test_muscles_respond_to_excitation(rigid: Simulation) -> None:
+    names = rigid.muscle_names
+    hamstrings = [names.index(h) for h in HAMSTRINGS]
+    vasti = [names.index(v) for v in ("vastus_lateralis", "vastus_medialis", "vastus_intermedius")]
+    # At rest the hamstrings flex the knee and the vasti extend it. (Moment arms are
+    # computed by step(): they read 0 before the first one.)
+    rigid.step(0.001)
+    assert np.all(rigid.moment_arms[hamstrings] > 0.0)
+    assert np.all(rigid.moment_arms[vasti] < 0.0)
+    rigid.set_excitations(dict.fromkeys(HAMSTRINGS, 1.0))
+    peak = np.zeros(len(names))
+    for _ in range(20):  # 0.2 s
+        rigid.step(0.001, n=10)
+        act = rigid.activations
+        assert np.all((act >= 0.0) & (act <= 1.0))
+        assert np.all(rigid.forces >= 0.0)
+        peak = np.maximum(peak, rigid.forces)
+    assert np.all(rigid.activations[hamstrings] > 0.5)
+    assert np.all(peak[hamstrings] > 0.0), dict(zip(HAMSTRINGS, peak[hamstrings]))
+    assert np.all(rigid.fibre_lengths > 0.0)
+
+
+# --- scalars -------------------------------------------------------------------------
+
+
+def test_scalar_properties(rigid: Simulation) -> None:
+    for name in ("time", "knee_angle", "knee_velocity", "knee_torque"):
+        v = getattr(rigid, name)
+        assert isinstance(v, float) and math.isfinite(v), name
+    lo, hi = rigid.knee_limits
+    assert isinstance(rigid.knee_limits, tuple)
+    assert isinstance(lo, float) and isinstance(hi, float)
+    assert lo < 0.5 < hi
+    assert lo <= rigid.knee_angle <= hi
+    assert isinstance(rigid.n_fat_elements, int) and rigid.n_fat_elements > 0
+    assert rigid.time == 0.0
+
+
+# --- surfaces ------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("layer", LAYERS)
+@pytest.mark.parametrize("with_tissue", [False, True], ids=["rigid", "tissue"])
+def test_surface(request: pytest.FixtureRequest, layer: str, with_tissue: bool) -> None:
+    sim: Simulation = request.getfixturevalue("tissue" if with_tissue else "rigid")
+    vertices, triangles = sim.surface(layer)
+    assert vertices.dtype == np.float32 and vertices.ndim == 2 and vertices.shape[1] == 3
+    assert triangles.dtype == np.uint32 and triangles.ndim == 2 and triangles.shape[1] == 3
+    n, m = vertices.shape[0], triangles.shape[0]
+    assert n > 0 and m > 0
+    assert int(triangles.max()) < n
+    assert np.all(np.isfinite(vertices))
+    # A leg is tens of centimetres, in metres.
+    extent = vertices.max(axis=0) - vertices.min(axis=0)
+    assert 0.01 < float(extent.max()) < 3.0
+    v2, t2 = sim.surface(layer)
+    assert not np.shares_memory(vertices, v2) and not np.shares_memory(triangles, t2)
+
+
+def test_surface_follows_the_knee(rigid: Simulation) -> None:
+    before = rigid.surface("bone")[0]
+    flex(rigid, 0.3)
+    after = rigid.surface("bone")[0]
+    assert before.shape == after.shape
+    assert not np.array_equal(before, after)
+
+
+# --- stepping and excitations --------------------------------------------------------
+
+
+def test_step_advances_time_by_dt_times_n(rigid: Simulation) -> None:
+    t0 = rigid.time
+    rigid.step()
+    assert rigid.time == pytest.approx(t0 + 0.001, rel=0, abs=1e-12)
+    rigid.step(0.002, n=5)
+    assert rigid.time == pytest.approx(t0 + 0.011, rel=0, abs=1e-12)
+    rigid.step(dt=0.0005, n=4)
+    assert rigid.time == pytest.approx(t0 + 0.013, rel=0, abs=1e-12)
+
+
+def test_set_excitation_single(rigid: Simulation) -> None:
+    rigid.set_excitation("semimembranosus", 0.25)
+    e = rigid.excitations
+    i = rigid.muscle_names.index("semimembranosus")
+    assert e[i] == 0.25
+    assert np.count_nonzero(e) == 1
+
+
+def test_set_excitations_with_dict(rigid: Simulation) -> None:
+    rigid.set_excitations({"semitendinosus": 0.5, "vastus_lateralis": 0.125})
+    names = rigid.muscle_names
+    e = rigid.excitations
+    assert e[names.index("semitendinosus")] == 0.5
+    assert e[names.index("vastus_lateralis")] == 0.125
+    assert np.count_nonzero(e) == 2
+    # A dict only changes the muscles it names.
+    rigid.set_excitations({"semitendinosus": 0.0})
+    assert np.count_nonzero(rigid.excitations) == 1
+
+
+def test_set_excitations_with_array(rigid: Simulation) -> None:
+    n = len(rigid.muscle_names)
+    values = np.linspace(0.0, 1.0, n)
+    rigid.set_excitations(values)
+    assert np.array_equal(rigid.excitations, values)
+    rigid.set_excitations(np.full(n, 0.5, dtype=np.float32))
+    assert np.array_equal(rigid.excitations, np.full(n, 0.5))
+    rigid.set_excitations([0.25] * n)
+    assert np.array_equal(rigid.excitations, np.full(n, 0.25))
+    rigid.set_excitations(values[::-1])  # non-contiguous view
+    assert np.array_equal(rigid.excitations, values[::-1])
+
+
+def test_hamstrings_flex_the_knee(rigid: Simulation) -> None:
+    assert rigid.knee_angle < 0.1
+    flex(rigid, 0.5)
+    assert rigid.knee_angle > 0.5, f"knee at {rigid.knee_angle:.3f} rad after 0.5 s of hamstrings"
+
+
+def test_set_knee(rigid: Simulation) -> None:
+    rigid.set_knee(0.8)
+    assert rigid.knee_angle == pytest.approx(0.8, abs=1e-6)
+    assert rigid.knee_velocity == 0.0
+    rigid.set_knee(0.4, velocity=1.5)
+    assert rigid.knee_angle == pytest.approx(0.4, abs=1e-6)
+    assert rigid.knee_velocity == pytest.approx(1.5)
+
+
+# --- determinism and checkpoints -----------------------------------------------------
+
+
+def _scripted_run(sim: Simulation) -> dict[str, object]:
+    sim.set_excitations({"semimembranosus": 0.7, "vastus_lateralis": 0.2})
+    sim.step(0.001, n=80)
+    sim.set_excitation("biceps_femoris_short", 1.0)
+    for _ in range(40):
+        sim.step(0.001)
+    return snapshot(sim)
+
+
+@pytest.mark.parametrize("with_tissue", [False, True], ids=["rigid", "tissue"])
+def test_determinism_two_simulations(with_tissue: bool) -> None:
+    a = Simulation.phantom(tissue=with_tissue)
+    b = Simulation.phantom(tissue=with_tissue)
+    assert_identical(snapshot(a), snapshot(b))
+    ra, rb = _scripted_run(a), _scripted_run(b)
+    assert_identical(ra, rb)
+    assert a.knee_angle == b.knee_angle
+
+
+@pytest.mark.parametrize("with_tissue", [False, True], ids=["rigid", "tissue"])
+def test_state_round_trip_is_bit_identical(request: pytest.FixtureRequest, with_tissue: bool) -> None:
+    sim: Simulation = request.getfixturevalue("tissue" if with_tissue else "rigid")
+    flex(sim, 0.05)
+    checkpoint = sim.state()
+    assert isinstance(checkpoint, State)
+    assert isinstance(checkpoint.time, float)
+    assert checkpoint.time == sim.time
+    before = snapshot(sim)
+
+    def run() -> tuple[list[float], dict[str, object]]:
+        angles = []
+        for _ in range(100):
+            sim.step(0.001)
+            angles.append(sim.knee_angle)
+        return angles, snapshot(sim)
+
+    angles_1, end_1 = run()
+    sim.set_state(checkpoint)
+    assert sim.time == checkpoint.time
+    assert sim.state().time == checkpoint.time
+    assert_identical(snapshot(sim), before)
+    angles_2, end_2 = run()
+    assert angles_1 == angles_2
+    assert_identical(end_1, end_2)
+
+
+def test_state_is_independent_of_later_steps(rigid: Simulation) -> None:
+    checkpoint = rigid.state()
+    t = checkpoint.time
+    flex(rigid, 0.1)
+    assert checkpoint.time == t
+    assert rigid.time > t
+
+
+# --- tissue metrics ------------------------------------------------------------------
+
+
+def test_tissue_arrays_with_tissue(tissue: Simulation) -> None:
+    flex(tissue, 0.3)
+    n_fat = tissue.n_fat_elements
+    assert n_fat > 0
+    for name in PER_FAT_F32:
+        a = getattr(tissue, name)
+        assert isinstance(a, np.ndarray) and a.dtype == np.float32, name
+        assert a.shape == (n_fat,), name
+        assert np.all(np.isfinite(a)), name
+    assert np.all(tissue.deformation_degree >= 0.0)
+    mvr = tissue.muscle_volume_ratio
+    assert mvr.dtype == np.float32 and mvr.shape == (len(tissue.muscle_names),)
+    assert np.all(np.isfinite(mvr)) and np.all(mvr > 0.0)
+    assert float(np.abs(tissue.area_change).max()) > 0.0, "the skin did not deform after flexion"
+
+
+def test_tissue_elements_do_not_invert(tissue: Simulation) -> None:
+    flex(tissue, 0.3)
+    ratio = tissue.volume_ratio
+    inverted = int(np.count_nonzero(ratio <= 0.0))
+    assert inverted == 0, (
+        f"{inverted} of {ratio.size} fat elements inverted (volume ratio <= 0, min {ratio.min():.3f}) "
+        "after 0.3 s of hamstring flexion"
+    )
+
+
+def test_tissue_arrays_without_tissue(rigid: Simulation) -> None:
+    flex(rigid, 0.05)
+    for name in (*PER_FAT_F32, "muscle_volume_ratio"):
+        a = getattr(rigid, name)
+        assert isinstance(a, np.ndarray) and a.dtype == np.float32, name
+        assert a.shape == (0,), name
+    assert rigid.n_fat_elements > 0

@@ -1,0 +1,246 @@
+"""Every bad input raises the documented exception class, with a useful message."""
+
+from __future__ import annotations
+
+import math
+import pickle
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import myoslice
+from myoslice import (
+    InvalidInputError,
+    ModelFileError,
+    MyoSliceError,
+    RendererUnavailableError,
+    Simulation,
+    SimulationError,
+    UnknownNameError,
+)
+
+# --- the hierarchy -------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("cls", "builtins"),
+    [
+        (InvalidInputError, (ValueError,)),
+        (UnknownNameError, (InvalidInputError, ValueError, KeyError)),
+        (ModelFileError, (OSError,)),
+        (SimulationError, (RuntimeError,)),
+        (RendererUnavailableError, (RuntimeError,)),
+    ],
+)
+def test_hierarchy(cls: type[Exception], builtins: tuple[type[Exception], ...]) -> None:
+    assert issubclass(cls, MyoSliceError)
+    for b in builtins:
+        assert issubclass(cls, b), f"{cls.__name__} should be a {b.__name__}"
+    assert cls.__module__ == "myoslice.errors"
+    assert getattr(myoslice, cls.__name__) is cls
+
+
+def test_unknown_name_error_prints_its_plain_message() -> None:
+    e = UnknownNameError("unknown muscle 'x' (did you mean 'y'?)")
+    assert str(e) == "unknown muscle 'x' (did you mean 'y'?)"  # KeyError would add quotes
+    assert e.args == ("unknown muscle 'x' (did you mean 'y'?)",)
+
+
+@pytest.mark.parametrize(
+    "cls", [InvalidInputError, UnknownNameError, ModelFileError, SimulationError, RendererUnavailableError]
+)
+def test_errors_pickle(cls: type[Exception]) -> None:
+    e = pickle.loads(pickle.dumps(cls("message")))
+    assert type(e) is cls and str(e) == "message"
+
+
+# --- names ---------------------------------------------------------------------------
+
+
+def test_unknown_muscle(rigid: Simulation) -> None:
+    with pytest.raises(UnknownNameError) as info:
+        rigid.set_excitation("semitendinosis", 0.5)
+    e = info.value
+    assert isinstance(e, MyoSliceError)
+    assert isinstance(e, InvalidInputError)
+    assert isinstance(e, ValueError)
+    assert isinstance(e, KeyError)
+    assert "did you mean" in str(e)
+    assert "semitendinosus" in str(e)
+    assert not str(e).startswith(("'", '"'))
+
+
+def test_unknown_muscle_caught_as_key_error(rigid: Simulation) -> None:
+    with pytest.raises(KeyError):
+        rigid.set_excitation("no_such_muscle", 0.5)
+
+
+def test_dict_with_unknown_muscle_changes_nothing(rigid: Simulation) -> None:
+    rigid.set_excitation("semitendinosus", 0.25)
+    before = rigid.excitations
+    with pytest.raises(UnknownNameError) as info:
+        rigid.set_excitations({"semitendinosus": 0.5, "vastus_lateralis_x": 0.1})
+    assert "vastus_lateralis_x" in str(info.value)
+    assert np.array_equal(rigid.excitations, before)
+
+
+# --- excitation values ---------------------------------------------------------------
+
+
+@pytest.mark.parametrize("value", [1.5, -0.1, math.nan, math.inf])
+def test_bad_excitation_value(rigid: Simulation, value: float) -> None:
+    with pytest.raises(InvalidInputError):
+        rigid.set_excitation("semitendinosus", value)
+    with pytest.raises(InvalidInputError):
+        rigid.set_excitations({"semitendinosus": value})
+    values = np.zeros(len(rigid.muscle_names))
+    values[0] = value
+    with pytest.raises(InvalidInputError):
+        rigid.set_excitations(values)
+    assert np.count_nonzero(rigid.excitations) == 0
+
+
+WRONG_SHAPES: dict[str, Callable[[int], tuple[int, ...]]] = {
+    "scalar": lambda n: (),
+    "empty": lambda n: (0,),
+    "n-1": lambda n: (n - 1,),
+    "n+1": lambda n: (n + 1,),
+    "2xn": lambda n: (2, n),
+    "nx1": lambda n: (n, 1),
+}
+
+
+@pytest.mark.parametrize("shape", WRONG_SHAPES.values(), ids=WRONG_SHAPES.keys())
+def test_excitations_array_of_wrong_shape(rigid: Simulation, shape: Callable[[int], tuple[int, ...]]) -> None:
+    with pytest.raises(InvalidInputError):
+        rigid.set_excitations(np.full(shape(len(rigid.muscle_names)), 0.5))
+    assert np.count_nonzero(rigid.excitations) == 0
+
+
+def test_excitations_of_wrong_type(rigid: Simulation) -> None:
+    with pytest.raises((InvalidInputError, TypeError)):
+        rigid.set_excitations("semitendinosus")
+    with pytest.raises((InvalidInputError, TypeError)):
+        rigid.set_excitations({"semitendinosus": "high"})  # type: ignore[dict-item]
+
+
+# --- stepping ------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("dt", [-0.001, 0.0, math.nan, math.inf, -math.inf])
+def test_bad_dt(rigid: Simulation, dt: float) -> None:
+    with pytest.raises(InvalidInputError) as info:
+        rigid.step(dt)
+    assert "dt" in str(info.value)
+    assert rigid.time == 0.0
+
+
+@pytest.mark.parametrize("n", [0, -1])
+def test_bad_step_count(rigid: Simulation, n: int) -> None:
+    with pytest.raises(InvalidInputError):
+        rigid.step(0.001, n=n)
+    assert rigid.time == 0.0
+
+
+@pytest.mark.parametrize(("angle", "velocity"), [(10.0, 0.0), (math.nan, 0.0), (0.5, math.nan)])
+def test_bad_set_knee(rigid: Simulation, angle: float, velocity: float) -> None:
+    with pytest.raises(InvalidInputError):
+        rigid.set_knee(angle, velocity)
+
+
+# --- construction --------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {"muscle_model": "bogus"},
+        {"body_mass_kg": -1.0},
+        {"height_m": math.nan},
+        {"max_step_s": 0.0},
+    ],
+    ids=lambda kw: next(iter(kw)),
+)
+def test_bad_phantom_option(kwargs: dict[str, object]) -> None:
+    with pytest.raises(InvalidInputError):
+        Simulation.phantom(**kwargs)  # type: ignore[arg-type]
+
+
+def test_missing_nifti_file(tmp_path: Path) -> None:
+    labels = tmp_path / "labels.json"
+    labels.write_text("{}")
+    with pytest.raises(ModelFileError) as info:
+        Simulation.from_nifti(tmp_path / "missing.nii.gz", labels)
+    assert isinstance(info.value, OSError)
+    assert isinstance(info.value, MyoSliceError)
+    assert "missing.nii.gz" in str(info.value)
+
+
+def test_missing_label_table(tmp_path: Path) -> None:
+    volume = tmp_path / "volume.nii"
+    volume.write_bytes(b"")
+    with pytest.raises(ModelFileError):
+        Simulation.from_nifti(str(volume), str(tmp_path / "missing_labels.json"))
+
+
+def test_corrupt_nifti_file(tmp_path: Path) -> None:
+    volume = tmp_path / "volume.nii"
+    volume.write_bytes(b"not a nifti file at all" * 20)
+    labels = tmp_path / "labels.json"
+    labels.write_text("{}")
+    with pytest.raises(ModelFileError):
+        Simulation.from_nifti(volume, labels)
+
+
+def test_missing_scenario_file(tmp_path: Path) -> None:
+    with pytest.raises(ModelFileError) as info:
+        Simulation.from_scenario(tmp_path / "missing.toml")
+    assert isinstance(info.value, OSError)
+
+
+def test_scenario_with_unknown_key(tmp_path: Path) -> None:
+    path = tmp_path / "bad.toml"
+    path.write_text("[simulation]\nduration_s = 0.1\nbogus_key_xyz = 3\n")
+    with pytest.raises(MyoSliceError) as info:
+        Simulation.from_scenario(path)
+    assert "bogus_key_xyz" in str(info.value)
+
+
+def test_scenario_that_is_not_toml(tmp_path: Path) -> None:
+    path = tmp_path / "bad.toml"
+    path.write_text("this is [not toml\n")
+    with pytest.raises(MyoSliceError):
+        Simulation.from_scenario(str(path))
+
+
+# --- surfaces, checkpoints and rendering ---------------------------------------------
+
+
+def test_unknown_surface_layer(rigid: Simulation) -> None:
+    with pytest.raises(InvalidInputError) as info:
+        rigid.surface("cartilage")
+    assert "cartilage" in str(info.value)
+
+
+def test_set_state_needs_a_state(rigid: Simulation) -> None:
+    with pytest.raises(TypeError):
+        rigid.set_state("not a state")  # type: ignore[arg-type]
+
+
+def test_bad_render_color(rigid: Simulation) -> None:
+    # Options are checked before any GPU is looked for, so this holds without one.
+    with pytest.raises(InvalidInputError) as info:
+        rigid.render(64, 64, color="rainbow")
+    assert "rainbow" in str(info.value)
+
+
+def test_bad_render_camera(rigid: Simulation) -> None:
+    with pytest.raises(InvalidInputError):
+        rigid.render(64, 64, camera="upside_down")
+
+
+def test_bad_render_size(rigid: Simulation) -> None:
+    with pytest.raises(InvalidInputError):
+        rigid.render(0, 0)

@@ -1,0 +1,145 @@
+"""Scenario runs of the CLI: every example scenario runs (short) and its outputs parse
+with real readers (meshio for VTU/PVD, pygltflib for GLB); CSV and summary schemas hold
+and agree; bad scenarios fail with a message naming the problem; an interrupted run leaves
+the frames written so far valid."""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import signal
+import subprocess
+import time
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import meshio
+import numpy as np
+import pygltflib
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+CLI = ROOT / "target" / "release" / "myoslice"
+SCENARIOS = sorted((ROOT / "assets" / "scenarios").glob("*.toml"))
+
+
+def cli() -> Path:
+    if not CLI.exists():
+        if os.environ.get("MYOSLICE_ALLOW_MISSING_CLI") == "1":
+            pytest.skip("myoslice CLI not built")
+        pytest.fail(f"{CLI} not found: build it with `cargo build --release -p myoslice-cli`")
+    return CLI
+
+
+def run(scenario: Path, out: Path, duration: float = 0.2) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [str(cli()), "run", str(scenario), "--out", str(out), "--quiet", "--duration", str(duration)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+
+
+def test_there_are_the_four_example_scenarios() -> None:
+    names = {p.stem for p in SCENARIOS}
+    assert {"knee_flexion", "knee_extension", "co_contraction", "fast_flexion"} <= names
+
+
+@pytest.mark.parametrize("scenario", SCENARIOS, ids=lambda p: p.stem)
+def test_each_example_scenario_runs_and_its_outputs_parse(scenario: Path, tmp_path: Path) -> None:
+    r = run(scenario, tmp_path)
+    assert r.returncode == 0, r.stderr
+    # ParaView series: the PVD lists every VTU, each readable with its cell data.
+    pvd = ET.parse(tmp_path / "series.pvd").getroot()
+    files = [d.get("file") for d in pvd.iter("DataSet")]
+    assert len(files) >= 2
+    for f in files:
+        m = meshio.read(tmp_path / f)
+        kinds = {c.type for c in m.cells}
+        assert {"hexahedron", "triangle"} <= kinds
+        for key in ("structure_id", "kind", "area_change", "deformation_degree", "volume_ratio"):
+            assert key in m.cell_data, key
+        hexes = [c for c in m.cells if c.type == "hexahedron"][0].data
+        assert hexes.max() < len(m.points)
+        assert np.isfinite(m.points).all()
+    # Blender: a glTF 2.0 binary with the skin's morph targets and an animation.
+    g = pygltflib.GLTF2().load(str(tmp_path / "motion.glb"))
+    assert g.asset.version == "2.0"
+    assert g.animations and g.animations[0].channels
+    skin = [m for m in g.meshes if m.name == "skin"][0]
+    assert len(skin.primitives[0].targets) == len(files) - 1
+    # Y up: the leg's long axis is the glTF y axis.
+    pos = g.accessors[skin.primitives[0].attributes.POSITION]
+    extent = np.array(pos.max) - np.array(pos.min)
+    assert extent[1] == extent.max()
+    # Time series and summary.
+    with open(tmp_path / "timeseries.csv", newline="") as f:
+        rows = list(csv.DictReader(f))
+    cols = rows[0].keys()
+    for c in ("time_s", "knee_angle_deg", "knee_velocity_deg_s", "knee_torque_nm", "semitendinosus_force_n", "semitendinosus_activation", "semitendinosus_excitation"):
+        assert c in cols, c
+    t = np.array([float(r["time_s"]) for r in rows])
+    assert np.all(np.diff(t) > 0)
+    angles = np.array([float(r["knee_angle_deg"]) for r in rows])
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    for key in ("knee_angle_range_deg", "min_fat_volume_ratio", "max_abs_area_change", "muscle_volume_ratio_range", "inverted_elements", "wall_time_s", "realtime_factor", "final_knee_angle_deg"):
+        assert key in summary, key
+    assert summary["knee_angle_range_deg"][0] == pytest.approx(angles.min(), abs=1e-4)
+    assert summary["knee_angle_range_deg"][1] == pytest.approx(angles.max(), abs=1e-4)
+    assert summary["final_knee_angle_deg"] == pytest.approx(angles[-1], abs=1e-4)
+    assert summary["frames"] == len(files)
+    assert summary["duration_s"] == pytest.approx(t[-1], abs=2e-3)
+
+
+def test_the_papers_experiment_flexes_the_knee_with_finite_tissue(tmp_path: Path) -> None:
+    r = run(ROOT / "assets" / "scenarios" / "knee_flexion.toml", tmp_path, duration=0.3)
+    assert r.returncode == 0, r.stderr
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert s["knee_angle_range_deg"][1] > 20.0, "the knee flexes (positive angles)"
+    assert s["knee_angle_range_deg"][0] >= -0.5
+    last = meshio.read(tmp_path / f"frame_{s['frames'] - 1:04d}.vtu")
+    assert np.isfinite(last.points).all()
+    assert 0.99 < s["muscle_volume_ratio_range"][0] <= s["muscle_volume_ratio_range"][1] < 1.01
+
+
+@pytest.mark.parametrize(
+    ("text", "needle"),
+    [
+        ("[simulation]\nduration_s = 1\nbogus = 1\n", "bogus"),
+        ("[simulation]\nduration_s = \"long\"\n", "duration_s"),
+        ("[simulation]\nduration_s = -1\n", "duration_s"),
+        ("[simulation]\nduration_s = 1\n[excitation]\nsemitendinosis = [[0.0, 0.5]]\n", "semitendinosus"),
+        ("[model]\nsource = \"nifti\"\nvolume = \"missing.nii.gz\"\nlabels = \"missing.json\"\n[simulation]\nduration_s = 1\n", "missing.nii.gz"),
+    ],
+    ids=["unknown-key", "wrong-type", "negative-duration", "unknown-muscle", "missing-model-file"],
+)
+def test_bad_scenarios_fail_with_a_message_naming_the_problem(text: str, needle: str, tmp_path: Path) -> None:
+    sc = tmp_path / "bad.toml"
+    sc.write_text(text)
+    r = subprocess.run([str(cli()), "run", str(sc), "--out", str(tmp_path / "out"), "--quiet"], capture_output=True, text=True, timeout=300)
+    assert r.returncode != 0
+    assert needle in r.stderr, r.stderr
+    assert "panicked" not in r.stderr
+
+
+def test_an_interrupted_run_leaves_valid_frames(tmp_path: Path) -> None:
+    p = subprocess.Popen(
+        [str(cli()), "run", str(ROOT / "assets" / "scenarios" / "knee_flexion.toml"), "--out", str(tmp_path), "--quiet"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    # Wait for a few frames, then interrupt.
+    deadline = time.time() + 300
+    while time.time() < deadline and len(list(tmp_path.glob("frame_*.vtu"))) < 3:
+        time.sleep(0.2)
+    p.send_signal(signal.SIGINT)
+    p.wait(timeout=60)
+    pvd = ET.parse(tmp_path / "series.pvd").getroot()
+    files = [d.get("file") for d in pvd.iter("DataSet")]
+    assert len(files) >= 3
+    for f in files:
+        assert np.isfinite(meshio.read(tmp_path / f).points).all()
+    # A temporary *.partial file may remain from the frame being written; it is never listed.
+    rows = (tmp_path / "timeseries.csv").read_text().splitlines()
+    assert all(len(r.split(",")) == len(rows[0].split(",")) for r in rows)
