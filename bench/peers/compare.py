@@ -229,7 +229,7 @@ def main() -> int:
           "exactly constant moment arms. OpenSim uses DeGrooteFregly2016Muscle with a rigid tendon and "
           "point-to-point paths (flexor moment arms vary with angle; extensors wrap a 4.5 cm cylinder). "
           "myoslice's knee_hinge_16 uses its own muscle paths on the phantom (wrapping, chains of mass "
-          "points), not fixed moment arms, so the knee angles differ; they are printed to show the three do "
+          "points), not fixed moment arms, so the knee angles need not agree; they are printed to show the three do "
           "comparable work. popliteus and plantaris have no catalogue numbers: the peers give them 100 N, "
           "5 cm, 5 cm, 0°.")
     if a.out:

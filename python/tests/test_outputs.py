@@ -90,6 +90,20 @@ def test_each_example_scenario_runs_and_its_outputs_parse(scenario: Path, tmp_pa
     assert summary["final_knee_angle_deg"] == pytest.approx(angles[-1], abs=1e-4)
     assert summary["frames"] == len(files)
     assert summary["duration_s"] == pytest.approx(t[-1], abs=2e-3)
+    assert summary["rows"] == len(rows)
+    assert summary["realtime_factor"] == pytest.approx(summary["duration_s"] / summary["wall_time_s"], rel=1e-6)
+    # The tissue extremes agree with the frames written (the summary may also have seen
+    # tissue updates between frames, so it is at least as extreme).
+    def fat_cells(f: str, key: str) -> np.ndarray:
+        m = meshio.read(tmp_path / f)
+        block = [i for i, c in enumerate(m.cells) if c.type == "hexahedron"][0]
+        return np.asarray(m.cell_data[key][block])
+
+    ratios = np.concatenate([fat_cells(f, "volume_ratio") for f in files])
+    areas = np.concatenate([fat_cells(f, "area_change") for f in files])
+    assert summary["min_fat_volume_ratio"] <= ratios.min() + 1e-6
+    assert summary["max_abs_area_change"] >= np.abs(areas).max() - 1e-6
+    assert summary["inverted_elements"] == 0 and ratios.min() > 0.0
 
 
 def test_the_papers_experiment_flexes_the_knee_with_finite_tissue(tmp_path: Path) -> None:
@@ -100,6 +114,8 @@ def test_the_papers_experiment_flexes_the_knee_with_finite_tissue(tmp_path: Path
     assert s["knee_angle_range_deg"][0] >= -0.5
     last = meshio.read(tmp_path / f"frame_{s['frames'] - 1:04d}.vtu")
     assert np.isfinite(last.points).all()
+    assert s["inverted_elements"] == 0, "no fat element turned inside out"
+    assert s["min_fat_volume_ratio"] > 0.0
     assert 0.99 < s["muscle_volume_ratio_range"][0] <= s["muscle_volume_ratio_range"][1] < 1.01
 
 
@@ -134,10 +150,12 @@ def test_an_interrupted_run_leaves_valid_frames(tmp_path: Path) -> None:
     while time.time() < deadline and len(list(tmp_path.glob("frame_*.vtu"))) < 3:
         time.sleep(0.2)
     p.send_signal(signal.SIGINT)
-    p.wait(timeout=60)
+    code = p.wait(timeout=60)
+    assert code != 0, "the run finished before it was interrupted: the test proves nothing"
+    assert not (tmp_path / "summary.json").exists(), "an interrupted run writes no summary"
     pvd = ET.parse(tmp_path / "series.pvd").getroot()
     files = [d.get("file") for d in pvd.iter("DataSet")]
-    assert len(files) >= 3
+    assert 3 <= len(files) < 31, f"{len(files)} frames listed of the scenario's 31"
     for f in files:
         assert np.isfinite(meshio.read(tmp_path / f).points).all()
     # A temporary *.partial file may remain from the frame being written; it is never listed.

@@ -28,7 +28,7 @@ OVERHEAD_FILE = Path(__file__).resolve().parent / ".last_overhead.txt"
 
 EXCITE = {"semimembranosus": 0.7, "vastus_lateralis": 0.2}
 # Timings take the best of this many interleaved runs (more help on a busy machine).
-RUNS = int(os.environ.get("MYOSLICE_TIMING_RUNS", "3"))
+RUNS = int(os.environ.get("MYOSLICE_TIMING_RUNS", "5"))
 
 
 def cli() -> Path:
@@ -146,4 +146,4 @@ def test_throughput_and_call_overhead(fresh_rigid: tuple[Simulation, State]) -> 
     OVERHEAD_FILE.write_text(summary)
 
     assert math.isfinite(overhead_us)
-    assert python <= rust * 1.05 + 0.005, f"the binding is slower than the CLI:\n{summary}"
+    assert python <= rust * 1.05, f"the binding costs more than 5 % over the CLI:\n{summary}"

@@ -252,7 +252,14 @@ impl App {
                 ..SceneOptions::default()
             },
         );
-        OrbitCamera::framing(s.bounds.0, s.bounds.1, preset)
+        OrbitCamera::framing(s.bounds.0, s.bounds.1, preset, self.aspect())
+    }
+
+    /// Width over height of the window (16:9 before it exists).
+    fn aspect(&self) -> f32 {
+        self.gfx.as_ref().map_or(16.0 / 9.0, |g| {
+            g.config.width as f32 / g.config.height.max(1) as f32
+        })
     }
 
     fn redraw(&mut self) {
@@ -303,8 +310,15 @@ impl App {
             ..SceneOptions::default()
         };
         let scene = SceneMesh::build(&self.sim, &opts);
+        self.ui.color_range = scene.color_range;
+        let aspect = g.config.width as f32 / g.config.height.max(1) as f32;
         let camera = *self.camera.get_or_insert_with(|| {
-            OrbitCamera::framing(scene.bounds.0, scene.bounds.1, CameraPreset::Oblique)
+            OrbitCamera::framing(
+                scene.bounds.0,
+                scene.bounds.1,
+                CameraPreset::Oblique,
+                aspect,
+            )
         });
         let mut enc = g
             .gpu

@@ -56,8 +56,10 @@ pub struct OrbitCamera {
 }
 
 impl OrbitCamera {
-    /// A camera framing the box `[lo, hi]` from a preset.
-    pub fn framing(lo: Vec3, hi: Vec3, preset: CameraPreset) -> Self {
+    /// A camera framing the box `[lo, hi]` from a preset, for a viewport of `aspect`
+    /// (width / height): the box's projected corners fill about 90 % of the tighter
+    /// direction, centred.
+    pub fn framing(lo: Vec3, hi: Vec3, preset: CameraPreset, aspect: f32) -> Self {
         let (yaw, pitch) = match preset {
             CameraPreset::Front => (0.0, 0.05),
             // +x is the subject's right: the lateral side of a left leg is at -x.
@@ -67,15 +69,48 @@ impl OrbitCamera {
             CameraPreset::Oblique => (0.6, 0.3),
         };
         let fov_y = 35f32.to_radians();
-        let size = hi - lo;
-        let radius = 0.5 * size.length().max(1e-3);
-        Self {
+        let mut cam = Self {
             target: 0.5 * (lo + hi),
-            distance: radius / (0.5 * fov_y).tan() * 1.08,
+            distance: 1.0,
             yaw,
             pitch,
             fov_y,
-        }
+        };
+        // View axes: toward the eye, right and up.
+        let back = (cam.eye() - cam.target).normalize_or(Vec3::Y);
+        let right = Vec3::Z.cross(back).normalize_or(Vec3::X);
+        let up = back.cross(right);
+        let corners: Vec<Vec3> = (0..8)
+            .map(|c| {
+                Vec3::new(
+                    if c & 1 == 0 { lo.x } else { hi.x },
+                    if c & 2 == 0 { lo.y } else { hi.y },
+                    if c & 4 == 0 { lo.z } else { hi.z },
+                )
+            })
+            .collect();
+        // Centre the target on the box as seen from the eye.
+        let span = |axis: Vec3| {
+            corners
+                .iter()
+                .map(|p| (*p - cam.target).dot(axis))
+                .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), v| {
+                    (a.min(v), b.max(v))
+                })
+        };
+        let (r0, r1) = span(right);
+        let (u0, u1) = span(up);
+        cam.target += right * (0.5 * (r0 + r1)) + up * (0.5 * (u0 + u1));
+        let t = (0.5 * fov_y).tan() * 0.9;
+        let aspect = aspect.max(1e-3);
+        cam.distance = corners
+            .iter()
+            .map(|p| {
+                let d = *p - cam.target;
+                d.dot(back) + (d.dot(right).abs() / (t * aspect)).max(d.dot(up).abs() / t)
+            })
+            .fold(0.05f32, f32::max);
+        cam
     }
 
     /// Camera position.
@@ -131,7 +166,7 @@ mod tests {
     fn framing_puts_the_whole_box_in_view() {
         let (lo, hi) = (Vec3::new(-0.1, -0.1, 0.0), Vec3::new(0.1, 0.1, 0.9));
         for (p, _) in CameraPreset::ALL {
-            let c = OrbitCamera::framing(lo, hi, p);
+            let c = OrbitCamera::framing(lo, hi, p, 1.0);
             let vp = c.projection(1.0) * c.view();
             for corner in 0..8 {
                 let q = Vec3::new(
@@ -151,17 +186,17 @@ mod tests {
 
     #[test]
     fn the_side_preset_sees_the_left_legs_lateral_side() {
-        let c = OrbitCamera::framing(Vec3::ZERO, Vec3::ONE, CameraPreset::Side);
+        let c = OrbitCamera::framing(Vec3::ZERO, Vec3::ONE, CameraPreset::Side, 1.5);
         assert!(c.eye().x < c.target.x);
-        let m = OrbitCamera::framing(Vec3::ZERO, Vec3::ONE, CameraPreset::Medial);
+        let m = OrbitCamera::framing(Vec3::ZERO, Vec3::ONE, CameraPreset::Medial, 1.5);
         assert!(m.eye().x > m.target.x);
     }
 
     #[test]
     fn the_front_preset_looks_at_the_front_and_orbit_clamps_pitch() {
-        let mut c = OrbitCamera::framing(Vec3::ZERO, Vec3::ONE, CameraPreset::Front);
+        let mut c = OrbitCamera::framing(Vec3::ZERO, Vec3::ONE, CameraPreset::Front, 1.5);
         assert!(c.eye().y > c.target.y);
-        let b = OrbitCamera::framing(Vec3::ZERO, Vec3::ONE, CameraPreset::Back);
+        let b = OrbitCamera::framing(Vec3::ZERO, Vec3::ONE, CameraPreset::Back, 1.5);
         assert!(b.eye().y < b.target.y);
         c.orbit(0.0, 1e4, 0.01);
         assert_eq!(c.pitch, 1.5);

@@ -28,6 +28,8 @@ pub struct CaptureOptions {
     pub scene: SceneOptions,
     /// Draw the colour-bar legend.
     pub legend: bool,
+    /// Keep this camera instead of framing each picture on its own (animations).
+    pub fixed_camera: Option<OrbitCamera>,
 }
 
 impl Default for CaptureOptions {
@@ -38,6 +40,7 @@ impl Default for CaptureOptions {
             camera: CameraPreset::Oblique,
             scene: SceneOptions::default(),
             legend: true,
+            fixed_camera: None,
         }
     }
 }
@@ -114,7 +117,10 @@ impl Offscreen {
         opts: &CaptureOptions,
     ) -> Result<Vec<u8>> {
         let scene = SceneMesh::build(sim, &opts.scene);
-        let camera = OrbitCamera::framing(scene.bounds.0, scene.bounds.1, opts.camera);
+        let aspect = opts.width as f32 / opts.height.max(1) as f32;
+        let camera = opts.fixed_camera.unwrap_or_else(|| {
+            OrbitCamera::framing(scene.bounds.0, scene.bounds.1, opts.camera, aspect)
+        });
         let mut enc = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -217,8 +223,22 @@ pub fn capture_png(gpu: &Gpu, sim: &Simulation, opts: &CaptureOptions, path: &Pa
     write_png(path, opts.width, opts.height, &rgba)
 }
 
-/// Steps the simulation to `duration` seconds in `frames` equal parts and renders each:
-/// PNGs into `out_dir` (`frame_0000.png`, ...) and/or one animated GIF.
+/// Steps `sim` by `seconds` (in calls of at most a second) and updates its tissue for
+/// the picture.
+pub fn advance(sim: &mut Simulation, seconds: f64) -> Result<()> {
+    let mut left = seconds;
+    while left > 1e-12 {
+        let h = left.min(1.0);
+        sim.step(h)?;
+        left -= h;
+    }
+    sim.update_tissue()?;
+    Ok(())
+}
+
+/// Renders `frames` pictures from now to `duration` seconds later, both ends included:
+/// PNGs into `out_dir` (`frame_0000.png`, ...) and/or one animated GIF. The camera
+/// frames the whole motion (found by a dry run on a copy) and stays put.
 pub fn capture_frames(
     gpu: &Gpu,
     sim: &mut Simulation,
@@ -228,6 +248,24 @@ pub fn capture_frames(
     out_dir: Option<&Path>,
     gif_path: Option<&Path>,
 ) -> Result<()> {
+    let dt = if frames > 1 {
+        duration / (frames - 1) as f64
+    } else {
+        0.0
+    };
+    let mut opts = opts.clone();
+    if opts.fixed_camera.is_none() {
+        let mut dry = sim.clone();
+        let (mut lo, mut hi) = SceneMesh::build(&dry, &opts.scene).bounds;
+        for _ in 1..frames {
+            advance(&mut dry, dt)?;
+            let b = SceneMesh::build(&dry, &opts.scene).bounds;
+            (lo, hi) = (lo.min(b.0), hi.max(b.1));
+        }
+        let aspect = opts.width as f32 / opts.height.max(1) as f32;
+        opts.fixed_camera = Some(OrbitCamera::framing(lo, hi, opts.camera, aspect));
+    }
+    let opts = &opts;
     let mut off = Offscreen::new(gpu, opts.width, opts.height);
     if let Some(d) = out_dir {
         std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
@@ -244,12 +282,10 @@ pub fn capture_frames(
         }
         None => None,
     };
-    let dt = duration / frames.max(1) as f64;
     let delay = ((dt * 100.0).round() as u16).max(2);
     for k in 0..frames {
         if k > 0 {
-            sim.step(dt)?;
-            sim.update_tissue()?;
+            advance(sim, dt)?;
         }
         let mut rgba = off.render(gpu, sim, opts)?;
         if let Some(d) = out_dir {

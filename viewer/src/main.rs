@@ -7,7 +7,7 @@ use anyhow::{Context, Result, anyhow};
 use clap::Parser;
 use myoslice::prelude::*;
 use myoslice_viewer::camera::CameraPreset;
-use myoslice_viewer::capture::{CaptureOptions, capture_frames, capture_png};
+use myoslice_viewer::capture::{CaptureOptions, advance, capture_frames, capture_png};
 use myoslice_viewer::colormap::ColorMode;
 use myoslice_viewer::model::{ModelSource, Preset};
 use myoslice_viewer::scene::SceneOptions;
@@ -123,8 +123,26 @@ fn capture(args: &Args) -> Result<()> {
             }
         }
     }
-    let gpu = Gpu::headless()?;
+    if !(0.0..=1.0).contains(&args.skin_opacity) {
+        return Err(anyhow!("--skin-opacity must be between 0 and 1"));
+    }
+    let animation = args.frames.is_some() || args.gif.is_some() || args.out_dir.is_some();
+    if animation {
+        if args.gif.is_none() && args.out_dir.is_none() {
+            return Err(anyhow!(
+                "--frames needs --out-dir (PNG frames) or --gif (an animated GIF)"
+            ));
+        }
+        if args.frames == Some(0) {
+            return Err(anyhow!("--frames must be at least 1"));
+        }
+        if args.frames.unwrap_or(24) > 1 && args.time <= 0.0 {
+            return Err(anyhow!("an animation needs --time > 0 (the span it shows)"));
+        }
+    }
+    // The model first: a bad file is reported as such, with or without a GPU.
     let mut sim = build(args)?;
+    let gpu = Gpu::headless()?;
     let opts = CaptureOptions {
         width: args.width,
         height: args.height,
@@ -132,13 +150,14 @@ fn capture(args: &Args) -> Result<()> {
         scene: SceneOptions {
             color_mode: color,
             visible,
-            opacity: [1.0, 1.0, args.skin_opacity.clamp(0.0, 1.0)],
+            opacity: [1.0, 1.0, args.skin_opacity],
             ..SceneOptions::default()
         },
         legend: !args.no_legend,
+        fixed_camera: None,
     };
-    if args.frames.is_some() || args.gif.is_some() || args.out_dir.is_some() {
-        let frames = args.frames.unwrap_or(24).max(1);
+    if animation {
+        let frames = args.frames.unwrap_or(24);
         capture_frames(
             &gpu,
             &mut sim,
@@ -154,8 +173,7 @@ fn capture(args: &Args) -> Result<()> {
         return Ok(());
     }
     if args.time > 0.0 {
-        sim.step(args.time)?;
-        sim.update_tissue()?;
+        advance(&mut sim, args.time)?;
     }
     let path = args
         .capture

@@ -208,12 +208,15 @@ impl SceneMesh {
         }
         s.ranges[2] = start..s.indices.len() as u32;
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        for p in fat_x
-            .iter()
-            .chain(lat.bones.iter().flat_map(|b| b.mesh.vertices.iter()))
-        {
-            lo = lo.min(*p);
-            hi = hi.max(*p);
+        // The posed bones and skin, and whatever else is drawn (muscles may reach past both).
+        let posed_bones = lat.bones.iter().flat_map(|b| {
+            let body = body_of_bone(&b.name);
+            b.mesh.vertices.iter().map(move |p| frames.point(body, *p))
+        });
+        let drawn = s.vertices.iter().map(|v| Vec3::from_array(v.pos));
+        for p in fat_x.iter().copied().chain(posed_bones).chain(drawn) {
+            lo = lo.min(p);
+            hi = hi.max(p);
         }
         s.bounds = (lo, hi);
         s
@@ -228,6 +231,63 @@ impl SceneMesh {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use myoslice::SimulationConfig;
+
+    #[test]
+    fn the_scene_of_a_flexed_phantom_has_its_layers_visibility_colours_and_bounds() {
+        let mut sim = Simulation::phantom(SimulationConfig::default()).expect("phantom");
+        sim.set_knee(1.2, 0.0).expect("knee");
+        let lat = sim.lattice();
+        let all = SceneMesh::build(&sim, &SceneOptions::default());
+        let bone_tris: usize = lat.bones.iter().map(|b| b.mesh.triangles.len()).sum();
+        let muscle_tris: usize = lat.muscles.iter().map(|m| m.mesh.triangles.len()).sum();
+        assert_eq!(all.triangles(Layer::Bone), bone_tris);
+        assert_eq!(all.triangles(Layer::Muscle), muscle_tris);
+        assert_eq!(all.triangles(Layer::Skin), 2 * lat.fat.outer_faces().len());
+        assert_eq!(all.ranges[2].end as usize, all.indices.len());
+        assert!(
+            all.indices
+                .iter()
+                .all(|&i| (i as usize) < all.vertices.len())
+        );
+        let (lo, hi) = all.bounds;
+        for v in &all.vertices {
+            let p = Vec3::from_array(v.pos);
+            assert!(
+                p.cmpge(lo - 1e-5).all() && p.cmple(hi + 1e-5).all(),
+                "{p} outside"
+            );
+            assert!((Vec3::from_array(v.normal).length() - 1.0).abs() < 1e-3);
+        }
+        // Hidden layers draw nothing; the others keep their triangles.
+        let skin_only = SceneMesh::build(
+            &sim,
+            &SceneOptions {
+                visible: [false, false, true],
+                ..SceneOptions::default()
+            },
+        );
+        assert_eq!(skin_only.triangles(Layer::Bone), 0);
+        assert_eq!(skin_only.triangles(Layer::Muscle), 0);
+        assert_eq!(skin_only.triangles(Layer::Skin), all.triangles(Layer::Skin));
+        // After a flexion the area colours leave the skin colour somewhere; "none" nowhere.
+        let skin_colours = |mode| {
+            let m = SceneMesh::build(
+                &sim,
+                &SceneOptions {
+                    color_mode: mode,
+                    visible: [false, false, true],
+                    ..SceneOptions::default()
+                },
+            );
+            m.vertices
+                .iter()
+                .filter(|v| v.color[..3] != colormap::SKIN[..3])
+                .count()
+        };
+        assert!(skin_colours(ColorMode::Area) > 100);
+        assert_eq!(skin_colours(ColorMode::None), 0);
+    }
 
     #[test]
     fn normals_of_a_tetrahedron_point_outward() {

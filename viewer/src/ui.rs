@@ -8,7 +8,7 @@ use myoslice::Simulation;
 use myoslice::muscle::MuscleGroup;
 
 use crate::camera::CameraPreset;
-use crate::colormap::ColorMode;
+use crate::colormap::{self, ColorMode};
 use crate::model::{ModelSource, Preset};
 
 /// Samples kept for the live plot.
@@ -91,6 +91,8 @@ pub struct UiState {
     pub error: Option<String>,
     /// Last frame time (ms) and simulation time per frame (ms).
     pub frame_ms: f32,
+    /// Scale of the surface colours in the last frame (log2 area ratio, or metres).
+    pub color_range: f32,
     /// Wall time of the last simulation advance (ms).
     pub sim_ms: f32,
     /// Path fields of the "open model" form.
@@ -114,6 +116,7 @@ impl Default for UiState {
             history: History::default(),
             error: None,
             frame_ms: 0.0,
+            color_range: 1.0,
             sim_ms: 0.0,
             open_volume: String::new(),
             open_labels: String::new(),
@@ -341,21 +344,67 @@ impl UiState {
                 }
             }
         });
-        match self.color_mode {
-            ColorMode::Area => {
-                ui.label(
-                    egui::RichText::new("white: no change · blue: surface grew · red: shrank")
-                        .small(),
-                );
+        self.legend(ui);
+    }
+
+    /// The colour bar of the surface colours, with its scale.
+    fn legend(&self, ui: &mut egui::Ui) {
+        let r = self.color_range.max(1e-6);
+        let color_at = |t: f32| -> [f32; 3] {
+            match self.color_mode {
+                // t in [0, 1] spans area ratios 2^-r .. 2^r.
+                ColorMode::Area => colormap::area_color((r * (2.0 * t - 1.0)).exp2() - 1.0, r),
+                ColorMode::Degree => colormap::degree_color(t * r, r),
+                ColorMode::None => colormap::SKIN,
             }
-            ColorMode::Degree => {
-                ui.label(
-                    egui::RichText::new("white: undeformed → dark orange: most deformed (Eq. 5)")
-                        .small(),
-                );
+        };
+        let (labels, caption) = match self.color_mode {
+            ColorMode::Area => (
+                [
+                    format!("{:+.0} %", 100.0 * ((-r).exp2() - 1.0)),
+                    "no change".to_string(),
+                    format!("{:+.0} %", 100.0 * (r.exp2() - 1.0)),
+                ],
+                "body-surface area change: red shrank, blue grew",
+            ),
+            ColorMode::Degree => (
+                [
+                    "0 mm".to_string(),
+                    format!("{:.1} mm", 500.0 * r),
+                    format!("{:.1} mm", 1000.0 * r),
+                ],
+                "deformation degree (paper Eq. 5)",
+            ),
+            ColorMode::None => return,
+        };
+        let width = ui.available_width().min(280.0);
+        let (rect, _) = ui.allocate_exact_size(egui::vec2(width, 14.0), egui::Sense::hover());
+        let mut mesh = egui::Mesh::default();
+        const STEPS: u32 = 32;
+        for k in 0..=STEPS {
+            let t = k as f32 / STEPS as f32;
+            let c = color_at(t);
+            let c = egui::Color32::from(egui::Rgba::from_rgb(c[0], c[1], c[2]));
+            let x = rect.left() + t * rect.width();
+            mesh.colored_vertex(egui::pos2(x, rect.top()), c);
+            mesh.colored_vertex(egui::pos2(x, rect.bottom()), c);
+            if k > 0 {
+                let i = 2 * k;
+                mesh.add_triangle(i - 2, i - 1, i);
+                mesh.add_triangle(i - 1, i + 1, i);
             }
-            ColorMode::None => {}
         }
+        ui.painter().add(egui::Shape::mesh(mesh));
+        ui.horizontal(|ui| {
+            ui.set_width(width);
+            ui.label(egui::RichText::new(&labels[0]).small());
+            ui.add_space((width - 150.0).max(0.0) / 2.0);
+            ui.label(egui::RichText::new(&labels[1]).small());
+            ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| {
+                ui.label(egui::RichText::new(&labels[2]).small());
+            });
+        });
+        ui.label(egui::RichText::new(caption).small());
     }
 
     fn plot(&mut self, ui: &mut egui::Ui, sim: &Simulation) {

@@ -160,7 +160,20 @@ fn load(m: &ModelArgs) -> Result<(LabelVolume, LabelTable, String)> {
     }
 }
 
+/// A spinner on stderr naming the stage of a multi-second job (drawn only on a terminal).
+fn stages() -> indicatif::ProgressBar {
+    let pb = indicatif::ProgressBar::new_spinner();
+    pb.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {elapsed:>4} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+    );
+    pb.enable_steady_tick(std::time::Duration::from_millis(120));
+    pb
+}
+
 fn build(args: &BuildArgs) -> Result<()> {
+    let pb = stages();
+    pb.set_message("reading the label volume");
     let t0 = Instant::now();
     let (volume, table, source) = load(&args.model)?;
     let read = t0.elapsed().as_secs_f64();
@@ -172,10 +185,15 @@ fn build(args: &BuildArgs) -> Result<()> {
         rays: args.model.rays,
         ..BuildOptions::default()
     };
+    pb.set_message("building the lattice");
     let t1 = Instant::now();
     let lattice = Lattice::build(&volume, &table, &opts)?;
     let build_time = t1.elapsed().as_secs_f64();
+    pb.set_message("measuring volumes and coverage");
     let mut report = BuildReport::measure(&volume, &lattice, &source);
+    pb.set_message("checking invariants");
+    let inv = lattice.check_invariants();
+    pb.finish_and_clear();
     report.read_time_s = read;
     report.build_time_s = build_time;
     println!(
@@ -199,7 +217,6 @@ fn build(args: &BuildArgs) -> Result<()> {
         "{} slices x {} rays: {} vertices, {} fat hexahedra, {} muscle elements; read {:.2} s, build {:.2} s",
         t.slices, t.rays, t.vertices, t.fat_elements, t.muscle_elements, read, build_time
     );
-    let inv = lattice.check_invariants();
     println!(
         "invariants: open bones {:?}, fat elements <= 0: {}, muscle elements <= 0: {}/{}, fat vertices in bone: {}, duplicates {:?}",
         inv.open_bones,

@@ -5,7 +5,7 @@
 mod common;
 
 use std::hint::black_box;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use myoslice::tissue::FatSolver;
@@ -32,8 +32,17 @@ fn fat(c: &mut Criterion) {
         for threads in [1, 2] {
             let pool = common::pool(threads);
             let mut s = base.clone();
+            // Whole batches inside the pool: no thread hand-over per iteration.
             g.bench_function(format!("{threads}_threads"), |b| {
-                b.iter(|| pool.install(|| s.iterate(black_box(0.5))))
+                b.iter_custom(|iters| {
+                    pool.install(|| {
+                        let t = Instant::now();
+                        for _ in 0..iters {
+                            s.iterate(black_box(0.5));
+                        }
+                        t.elapsed()
+                    })
+                })
             });
         }
         g.finish();

@@ -106,9 +106,12 @@ fn passive_shank_swings_with_the_compound_pendulum_period_and_keeps_its_energy()
     );
     // Energy of the swing: m g d (1 - cos 3°).
     let swing = inertia.mass * 9.81 * d * (1.0 - 3f64.to_radians().cos());
+    // Measured against the swing's own energy, not the (much larger) potential energy
+    // from the rest pose.
     assert!(
-        max_drift < 0.01 * swing.max(e0.abs()),
-        "energy drift {max_drift:.2e} J vs swing energy {swing:.2e} J"
+        max_drift < 0.01 * swing,
+        "energy drift {max_drift:.2e} J is {:.2} % of the swing energy {swing:.2e} J",
+        100.0 * max_drift / swing
     );
 }
 

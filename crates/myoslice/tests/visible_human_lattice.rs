@@ -41,6 +41,23 @@ fn visible_human_lattice_matches_voxel_volumes_and_region_shapes() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+    // The fat lattice holds the subcutaneous fat; against all fat voxels (intermuscular
+    // fat, tendons and ligaments included, which lie inside the envelope) it must still
+    // be within 10 %.
+    let json: serde_json::Value = serde_json::from_str(&report.to_json()).unwrap();
+    let all_fat = json["totals"]["fat_all_voxel_volume_cm3"].as_f64().unwrap();
+    let fat = report
+        .structures
+        .iter()
+        .find(|s| s.kind == TissueKind::Fat)
+        .unwrap();
+    let off = fat.lattice_volume_cm3 / all_fat - 1.0;
+    assert!(
+        off.abs() < 0.10,
+        "fat lattice {:.0} cm³ against {all_fat:.0} cm³ of fat voxels ({:+.1} %)",
+        fat.lattice_volume_cm3,
+        100.0 * off
+    );
     // Every muscle and bone of the table made it into the lattice.
     for l in table.labels() {
         if matches!(l.kind, TissueKind::Bone | TissueKind::Muscle) {

@@ -35,7 +35,7 @@ pub struct ConeAnchor {
 }
 
 /// How far (share of the rest depth, at least [`DEPTH_SLACK_MIN`]) a cone-anchored point
-/// may move toward or away from its apex.
+/// may move away from its apex beyond its rest depth.
 pub const DEPTH_SLACK: f32 = 0.25;
 
 /// Least depth slack (m).
@@ -50,7 +50,7 @@ impl ConeAnchor {
             body,
             apex,
             axis,
-            depth: [(d - slack).max(0.0), d + slack],
+            depth: [0.0, d + slack],
         }
     }
 }
@@ -591,6 +591,26 @@ pub fn project_into_cone(p: Vec3, apex: Vec3, axis: Vec3, (cos_a, tan_a): (f32, 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_cone_point_cannot_bowstring_past_its_depth_bound_but_may_sink_toward_the_bone() {
+        let c = ConeAnchor::new(
+            BodyId::Thigh,
+            Vec3::ZERO,
+            Vec3::Z,
+            Vec3::new(0.0, 0.0, 0.04),
+        );
+        assert!(
+            c.depth[0] == 0.0 && (c.depth[1] - 0.05).abs() < 1e-6,
+            "{:?}",
+            c.depth
+        );
+        let out = clamp_depth(Vec3::new(0.0, 0.03, 0.09), Vec3::ZERO, c.depth);
+        assert!((out.length() - 0.05).abs() < 1e-6, "{out}");
+        assert!(out.normalize().dot(Vec3::new(0.0, 0.03, 0.09).normalize()) > 0.9999);
+        let near = Vec3::new(0.0, 0.0, 0.01);
+        assert_eq!(clamp_depth(near, Vec3::ZERO, c.depth), near);
+    }
 
     #[test]
     fn cone_projection_keeps_inside_points_and_lands_outside_ones_on_the_surface() {

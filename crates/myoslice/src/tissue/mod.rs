@@ -310,8 +310,9 @@ impl Tissue {
                 .push((v as u32, shape.current[mv as usize] + turn * offset));
         }
         // First guess, from the fold (so nothing accumulates): each radial column of
-        // vertices moves with its inner vertex where that follows a muscle; part of the
-        // last update's correction is carried over (inertia with damping).
+        // vertices moves with its inner vertex where that follows a muscle, keeping the
+        // fat's thickness; part of the last update's correction is carried over (inertia
+        // with damping).
         let momentum = self.config.momentum as f32;
         let lat = &lattice.fat;
         let mut guess = safe.clone();
@@ -320,8 +321,8 @@ impl Tissue {
             // Inner vertices are layer 0 of their column (see `FatLattice::vertex_index`).
             let inner = inner as usize;
             let delta = target - guess[inner];
-            for l in 0..l1 {
-                guess[inner + l] += delta * (1.0 - 0.5 * l as f32 / lat.layers as f32);
+            for (l, g) in guess[inner..inner + l1].iter_mut().enumerate() {
+                *g += delta * (1.0 - 0.5 * l as f32 / lat.layers as f32);
             }
         }
         for (i, p) in self.fat.x.iter_mut().enumerate() {
@@ -495,11 +496,32 @@ impl Tissue {
                     } else {
                         0.5 * share[i]
                     };
-                    self.fat.x[i] = safe[i] + (relaxed[i] - safe[i]) * share[i];
                 }
             }
             if moved_list.is_empty() {
                 break;
+            }
+            // The vertices around give back part of it too: a soft edge, not a step from
+            // one vertex to the next.
+            let n_bad = moved_list.len();
+            for k in 0..n_bad {
+                let v = moved_list[k];
+                let cap = (2.0 * share[v]).min(1.0);
+                for e in self.fat.elements_of(v) {
+                    for &u in &self.fat.hexes[e] {
+                        let u = u as usize;
+                        if share[u] > cap {
+                            share[u] = cap;
+                            if !moved_now[u] {
+                                moved_now[u] = true;
+                                moved_list.push(u);
+                            }
+                        }
+                    }
+                }
+            }
+            for &i in &moved_list {
+                self.fat.x[i] = safe[i] + (relaxed[i] - safe[i]) * share[i];
             }
         }
         share.iter().filter(|&&s| s < 1.0).count()

@@ -125,4 +125,29 @@ mod tests {
         let q2 = extract_rotation(&a, rot * Quat::from_rotation_z(0.1), 8);
         assert!(q2.angle_between(rot) < 1e-3);
     }
+
+    #[test]
+    fn trigonometry_free_steps_converge_from_a_warm_start_and_from_far() {
+        let rot = Quat::from_axis_angle(Vec3::new(-0.3, 0.8, 0.5).normalize(), 2.1);
+        let a = Mat3::from_quat(rot) * Mat3::from_diagonal(Vec3::new(0.6, 1.3, 0.9));
+        // Distance between rotations as the largest move of a unit axis (f32-safe).
+        let err = |q: Quat| {
+            [Vec3::X, Vec3::Y, Vec3::Z]
+                .iter()
+                .map(|e| (q * *e - rot * *e).length())
+                .fold(0.0f32, f32::max)
+        };
+        let mut q = rot * Quat::from_rotation_x(0.05);
+        for _ in 0..8 {
+            q = rotation_step(&a, q).0;
+        }
+        assert!(err(q) < 1e-4, "warm start: {}", err(q));
+        // From the identity the 0.5 rad clamp keeps each step sane; it still gets there.
+        let mut q = Quat::IDENTITY;
+        for _ in 0..60 {
+            q = rotation_step(&a, q).0;
+        }
+        assert!(err(q) < 1e-3, "from the identity: {}", err(q));
+        assert!((q.length() - 1.0).abs() < 1e-5);
+    }
 }
