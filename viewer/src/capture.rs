@@ -226,6 +226,10 @@ pub fn capture_png(gpu: &Gpu, sim: &Simulation, opts: &CaptureOptions, path: &Pa
 /// Steps `sim` by `seconds` (in calls of at most a second) and updates its tissue for
 /// the picture.
 pub fn advance(sim: &mut Simulation, seconds: f64) -> Result<()> {
+    anyhow::ensure!(
+        seconds.is_finite() && seconds >= 0.0,
+        "cannot advance by {seconds} s: expected a finite time >= 0"
+    );
     let mut left = seconds;
     while left > 1e-12 {
         let h = left.min(1.0);
@@ -236,7 +240,8 @@ pub fn advance(sim: &mut Simulation, seconds: f64) -> Result<()> {
     Ok(())
 }
 
-/// Renders `frames` pictures from now to `duration` seconds later, both ends included:
+/// Renders `frames` pictures from now to `duration` seconds later, both ends included
+/// (a single frame shows the end):
 /// PNGs into `out_dir` (`frame_0000.png`, ...) and/or one animated GIF. The camera
 /// frames the whole motion (found by a dry run on a copy) and stays put.
 pub fn capture_frames(
@@ -248,6 +253,10 @@ pub fn capture_frames(
     out_dir: Option<&Path>,
     gif_path: Option<&Path>,
 ) -> Result<()> {
+    // One frame shows the end of the span.
+    if frames == 1 && duration > 0.0 {
+        advance(sim, duration)?;
+    }
     let dt = if frames > 1 {
         duration / (frames - 1) as f64
     } else {

@@ -20,7 +20,9 @@ use glam::{Quat, Vec3};
 use crate::body::KneeAxis;
 use crate::lattice::hex_volume_points;
 
-/// Smallest Jacobian determinant the fold allows (volume may shrink to this share).
+/// Smallest Jacobian determinant the fold allows (volume may shrink to this share), up to
+/// a knee angle of about 154°; beyond, the two ramps would overlap and the back ramp
+/// stops widening (the validity guard still keeps the fat valid).
 pub const MIN_JACOBIAN: f32 = 0.3;
 
 /// Share of each ramp spent easing in and out (the rest is linear).
@@ -163,8 +165,7 @@ impl KneeFold {
     }
 
     /// How much the fold rules tissue at rest position `p` rather than its bone's rigid
-    /// motion: 1 where the weight is strictly between its end values, falling to 0 where
-    /// it is 0 or 1.
+    /// motion: `sqrt(4 w (1 − w))`, 1 where the weight is ½, 0 where it is 0 or 1.
     pub fn nearness(&self, p: Vec3) -> f32 {
         let w = self.weight(p);
         (4.0 * w * (1.0 - w)).clamp(0.0, 1.0).sqrt()
@@ -187,12 +188,16 @@ impl KneeFold {
     }
 }
 
+/// Rounds of repair for elements the fold turns over (see [`fold_hexes`]).
+const SMOOTHING_ROUNDS: usize = 6;
+
 /// A hexahedral lattice's rest shape `rest` carried by the fold (thigh rest frame). The
 /// map is orientation-preserving, but a skewed hexahedron much larger than the scale on
 /// which the weight varies (one reaching from near the axis to the back of the knee)
 /// can still turn over between its corners. Such an element moves its corners' weights
-/// toward their mean (which turns it rigidly), by the largest step that leaves every
-/// element touching it positive. Returns the positions and each vertex's weight.
+/// toward their mean (which turns it rigidly), by the largest step that improves it and
+/// turns no positive neighbour over, round after round. Returns the positions and each
+/// vertex's weight.
 pub fn fold_hexes(fold: &KneeFold, rest: &[Vec3], hexes: &[[u32; 8]]) -> (Vec<Vec3>, Vec<f32>) {
     let mut w: Vec<f32> = rest.iter().map(|&p| fold.weight(p)).collect();
     let place = |p: Vec3, w: f32| {
@@ -200,32 +205,63 @@ pub fn fold_hexes(fold: &KneeFold, rest: &[Vec3], hexes: &[[u32; 8]]) -> (Vec<Ve
     };
     let mut x: Vec<Vec3> = rest.iter().zip(&w).map(|(&p, &w)| place(p, w)).collect();
     let volume = |x: &[Vec3], h: &[u32; 8]| hex_volume_points(&h.map(|i| x[i as usize].as_dvec3()));
-    let turned: Vec<usize> = (0..hexes.len())
+    let mut turned: Vec<usize> = (0..hexes.len())
         .filter(|&e| volume(&x, &hexes[e]) <= 0.0)
         .collect();
-    for e in turned {
-        let h = hexes[e];
-        if volume(&x, &h) > 0.0 {
-            continue;
+    if turned.is_empty() {
+        return (x, w);
+    }
+    // Vertex → elements, only when something needs fixing (rare).
+    let mut of_vertex: Vec<Vec<u32>> = vec![Vec::new(); rest.len()];
+    for (e, h) in hexes.iter().enumerate() {
+        for &v in h {
+            of_vertex[v as usize].push(e as u32);
         }
-        // Elements sharing a corner with this one.
-        let touching: Vec<usize> = (0..hexes.len())
-            .filter(|&o| hexes[o].iter().any(|v| h.contains(v)))
-            .collect();
-        let mean = h.iter().map(|&i| w[i as usize]).sum::<f32>() / 8.0;
-        let before = h.map(|i| (w[i as usize], x[i as usize]));
-        for t in [1.0f32, 0.75, 0.5, 0.25] {
-            for (k, &i) in h.iter().enumerate() {
-                let wi = before[k].0 + t * (mean - before[k].0);
-                w[i as usize] = wi;
-                x[i as usize] = place(rest[i as usize], wi);
+    }
+    for _ in 0..SMOOTHING_ROUNDS {
+        let mut changed = false;
+        for &e in &turned {
+            let h = hexes[e];
+            let own = volume(&x, &h);
+            if own > 0.0 {
+                continue;
             }
-            if touching.iter().all(|&o| volume(&x, &hexes[o]) > 0.0) {
-                break;
+            let mut touching: Vec<u32> = h
+                .iter()
+                .flat_map(|&v| of_vertex[v as usize].iter().copied())
+                .collect();
+            touching.sort_unstable();
+            touching.dedup();
+            let before_vol: Vec<f64> = touching
+                .iter()
+                .map(|&o| volume(&x, &hexes[o as usize]))
+                .collect();
+            let mean = h.iter().map(|&i| w[i as usize]).sum::<f32>() / 8.0;
+            let before = h.map(|i| (w[i as usize], x[i as usize]));
+            for t in [1.0f32, 0.75, 0.5, 0.25] {
+                for (k, &i) in h.iter().enumerate() {
+                    let wi = before[k].0 + t * (mean - before[k].0);
+                    w[i as usize] = wi;
+                    x[i as usize] = place(rest[i as usize], wi);
+                }
+                // Accepted if this element improves and no positive neighbour turns over.
+                let ok = volume(&x, &h) > own
+                    && touching
+                        .iter()
+                        .zip(&before_vol)
+                        .all(|(&o, &v0)| v0 <= 0.0 || volume(&x, &hexes[o as usize]) > 0.0);
+                if ok {
+                    changed = true;
+                    break;
+                }
+                for (k, &i) in h.iter().enumerate() {
+                    (w[i as usize], x[i as usize]) = before[k];
+                }
             }
-            for (k, &i) in h.iter().enumerate() {
-                (w[i as usize], x[i as usize]) = before[k];
-            }
+        }
+        turned.retain(|&e| volume(&x, &hexes[e]) <= 0.0);
+        if !changed || turned.is_empty() {
+            break;
         }
     }
     (x, w)

@@ -45,9 +45,10 @@ pub struct TissueConfig {
     /// Half-gap (m) kept between the thigh and calf sides of the contact plane behind
     /// the knee. Default 0.001.
     pub contact_gap_m: f64,
-    /// No fat element may shrink below this share of its rest volume (or of its volume
-    /// in the knee fold, if that is smaller): where relaxation would, the tissue falls
-    /// back toward the fold locally (see [`Tissue`]). Default 0.05.
+    /// No fat element may shrink below half of this share of its rest volume (or half of
+    /// its volume in the knee fold, if that is smaller): where relaxation would, the
+    /// tissue falls back toward the fold locally (see [`Tissue`]). Default 0.05, i.e. a
+    /// floor at 2.5 % of rest volume.
     pub min_volume_ratio: f64,
     /// Keep the body surface from passing through itself near the knee (checked exactly,
     /// triangle against triangle, after every update). Default true.
@@ -89,9 +90,9 @@ const LAYER_GAP: f32 = 0.001;
 /// guarded against crossing; farther out the tissue moves nearly rigidly with its bone.
 const GUARD_RADIUS: f32 = 0.25;
 
-/// Rounds in which the validity guard halves the relaxation of offending vertices before
-/// it puts them on the fold outright.
-const GUARD_HALVINGS: usize = 2;
+/// Times the validity guard halves an offending vertex's relaxation before it puts the
+/// vertex on the fold outright.
+const GUARD_HALVINGS: u8 = 2;
 
 /// Squared distance (m²) from the fold below which a fat vertex counts as moving
 /// rigidly with its bone.
@@ -239,20 +240,33 @@ impl Tissue {
         frames: &BodyFrames,
         muscles: &[MuscleUnit],
     ) -> bool {
-        let backup = self.fat.x.clone();
-        let backup_theta = self.theta;
+        // Everything an update changes, to put back if it fails.
+        let backup = (
+            self.fat.x.clone(),
+            self.fat.rot.clone(),
+            self.fat.free.clone(),
+            self.fat.active.clone(),
+            self.drift.clone(),
+            self.theta,
+            self.metrics.clone(),
+            self.muscles
+                .iter()
+                .map(|m| m.current.clone())
+                .collect::<Vec<_>>(),
+        );
         self.deform(lattice, knee_angle, frames, muscles);
         let ok = self.fat.x.iter().all(|p| p.is_finite())
+            && self.drift.iter().all(|p| p.is_finite())
             && self
                 .muscles
                 .iter()
                 .all(|m| m.current.iter().all(|p| p.is_finite()));
         if !ok {
-            self.fat.x = backup;
-            self.theta = backup_theta;
-            for (shape, m) in self.muscles.iter_mut().zip(muscles) {
-                shape.current.clone_from(&shape.rest);
-                let _ = m;
+            let (x, rot, free, active, drift, theta, metrics, current) = backup;
+            (self.fat.x, self.fat.rot, self.fat.free, self.fat.active) = (x, rot, free, active);
+            (self.drift, self.theta, self.metrics) = (drift, theta, metrics);
+            for (shape, c) in self.muscles.iter_mut().zip(current) {
+                shape.current = c;
             }
         }
         ok
@@ -329,13 +343,29 @@ impl Tissue {
             *p = guess[i] + self.drift[i] * momentum;
         }
         // Relax only where the fat does not simply move with a bone.
-        let moving: Vec<bool> = (0..safe.len())
+        let mut moving: Vec<bool> = (0..safe.len())
             .map(|i| {
                 (weights[i] > 0.0 && weights[i] < 1.0)
                     || self.fat.x[i].distance_squared(safe[i]) > RIGID_TOLERANCE_M2
             })
             .collect();
+        for h in &self.fat.hexes {
+            let w0 = weights[h[0] as usize];
+            if h.iter().any(|&v| weights[v as usize] != w0) {
+                for &v in h {
+                    moving[v as usize] = true;
+                }
+            }
+        }
         self.fat.restrict_to(&moving);
+        // Elements left out turn with their bone: keep their warm start on that rotation,
+        // so that one becoming active later starts from its true orientation.
+        for (e, h) in self.fat.hexes.iter().enumerate() {
+            if !self.fat.active[e] {
+                let w = weights[h[0] as usize];
+                self.fat.rot[e] = tq * glam::Quat::from_axis_angle(fold.axis, theta * w);
+            }
+        }
         self.apply_muscles();
         self.apply_contact(&contact, gap);
         let k = self.config.stiffness as f32;
@@ -371,7 +401,8 @@ impl Tissue {
     fn apply_contact(&mut self, c: &Contact, gap: f32) {
         let l1 = self.layers + 1;
         for (v, (p, &s)) in self.fat.x.iter_mut().zip(&self.side).enumerate() {
-            if !self.posterior[v] {
+            // Vertices outside the relaxed region sit on the fold, which keeps its side.
+            if !self.posterior[v] || !self.fat.free[v] {
                 continue;
             }
             // Deeper layers stop further from the contact, so squeezed elements stay
@@ -410,8 +441,8 @@ impl Tissue {
     /// relaxed shape has an element below its allowed volume or body-surface triangles
     /// behind the knee that cross, the vertices involved give back half of their way from
     /// the fold (`safe`) to the relaxed shape, round after round, and after
-    /// [`GUARD_HALVINGS`] rounds take the fold outright. Elsewhere the relaxed shape
-    /// stands. After the first round only what the last round moved is looked at again.
+    /// [`GUARD_HALVINGS`] halvings take the fold outright; the vertices around them give
+    /// back part of the way too. Elsewhere the relaxed shape stands. After the first round only what the last round moved is looked at again.
     /// Returns how many vertices it moved off the relaxed shape.
     fn guard(&mut self, safe: &[Vec3]) -> usize {
         let eps = self.config.min_volume_ratio;
@@ -432,6 +463,7 @@ impl Tissue {
             .collect();
         let relaxed = self.fat.x.clone();
         let mut share = vec![1.0f32; relaxed.len()];
+        let mut halvings = vec![0u8; relaxed.len()];
         let mut bad = vec![false; relaxed.len()];
         let mut moved_now = vec![false; relaxed.len()];
         let mut moved_list: Vec<usize> = Vec::new();
@@ -455,8 +487,9 @@ impl Tissue {
                 }
             }
             if self.config.surface_guard {
-                // Triangles that kept the fold's rigid shape cannot cross each other; after
-                // the first round only those with a vertex just moved can have changed.
+                // Triangles outside the relaxed region are where the fold put them (the
+                // tests check the fold's skin for crossings); after the first round only
+                // those with a vertex just moved can have changed.
                 let live = if round == 0 {
                     &self.fat.free
                 } else {
@@ -491,7 +524,8 @@ impl Tissue {
                 if std::mem::take(b) && share[i] > 0.0 {
                     moved_now[i] = true;
                     moved_list.push(i);
-                    share[i] = if round + 1 >= GUARD_HALVINGS {
+                    halvings[i] += 1;
+                    share[i] = if halvings[i] >= GUARD_HALVINGS {
                         0.0
                     } else {
                         0.5 * share[i]
@@ -506,7 +540,7 @@ impl Tissue {
             let n_bad = moved_list.len();
             for k in 0..n_bad {
                 let v = moved_list[k];
-                let cap = (2.0 * share[v]).min(1.0);
+                let cap = 0.5 * (1.0 + share[v]);
                 for e in self.fat.elements_of(v) {
                     for &u in &self.fat.hexes[e] {
                         let u = u as usize;
@@ -522,6 +556,15 @@ impl Tissue {
             }
             for &i in &moved_list {
                 self.fat.x[i] = safe[i] + (relaxed[i] - safe[i]) * share[i];
+            }
+            if round + 1 == GUARD_MAX_ROUNDS {
+                // Out of rounds (not seen in practice): whatever was touched takes the fold.
+                for (i, sh) in share.iter_mut().enumerate() {
+                    if *sh < 1.0 {
+                        *sh = 0.0;
+                        self.fat.x[i] = safe[i];
+                    }
+                }
             }
         }
         share.iter().filter(|&&s| s < 1.0).count()
