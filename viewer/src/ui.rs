@@ -242,11 +242,7 @@ impl UiState {
     fn playback(&mut self, ui: &mut egui::Ui, actions: &mut Vec<UiAction>) {
         ui.horizontal(|ui| {
             if ui
-                .button(if self.playing {
-                    "⏸ Pause"
-                } else {
-                    "▶ Play"
-                })
+                .button(if self.playing { "Pause" } else { "Play" })
                 .clicked()
             {
                 self.playing = !self.playing;
@@ -466,6 +462,25 @@ impl UiState {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_ui_has_glyphs_for_every_character_of_its_labels() {
+        // egui ships no font unless asked (`default_fonts`): every label would be boxes.
+        let ctx = egui::Context::default();
+        let mut out = ctx.run_ui(egui::RawInput::default(), |_| {});
+        out.textures_delta.clear();
+        // Every character the interface's sources write, comments included (a superset).
+        let text: String = [include_str!("ui.rs"), include_str!("app.rs")].concat();
+        let mut chars: Vec<char> = text.chars().filter(|c| !c.is_control()).collect();
+        chars.sort_unstable();
+        chars.dedup();
+        let font = egui::FontId::proportional(14.0);
+        let missing: String = chars
+            .into_iter()
+            .filter(|c| !ctx.fonts_mut(|f| f.has_glyph(&font, *c)))
+            .collect();
+        assert!(missing.is_empty(), "no glyph for {missing:?}");
+    }
 
     #[test]
     fn history_keeps_a_bounded_window_and_resets_on_new_muscles() {

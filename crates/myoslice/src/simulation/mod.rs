@@ -22,6 +22,9 @@ use crate::muscle::{
 };
 use crate::tissue::{Tissue, TissueMetrics, bone_surfaces};
 
+/// Simulated time (s) the muscle chains settle at rest before time 0 (see `settle`).
+const SETTLE_S: f64 = 2.0;
+
 /// What a muscle reports.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MuscleReadout {
@@ -127,18 +130,10 @@ impl Simulation {
         let muscles = (0..lattice.muscles.len())
             .map(|i| MuscleUnit::build(&lattice, i, &meshes, &knee, catalogue, &opts))
             .collect::<Result<Vec<_>>>()?;
-        let tissue = if config.tissue.enabled {
-            let bones = bone_surfaces(&lattice, &meshes);
-            Some(Tissue::new(
-                &lattice,
-                &muscles,
-                knee,
-                bones,
-                config.tissue.clone(),
-            )?)
-        } else {
-            None
-        };
+        let bones = config
+            .tissue
+            .enabled
+            .then(|| bone_surfaces(&lattice, &meshes));
         let n = muscles.len();
         let mut sim = Self {
             lattice: Arc::new(lattice),
@@ -150,12 +145,55 @@ impl Simulation {
             steps: 0,
             frames: BodyFrames::REST,
             knee_torque: 0.0,
-            tissue,
+            tissue: None,
         };
+        if let Some(bones) = bones {
+            // The tissue's rest is the chains' equilibrium at rest (see `settle`); the
+            // simulation itself starts from the chains as built.
+            let mut rest = sim.clone();
+            rest.settle();
+            sim.tissue = Some(Tissue::new(
+                &sim.lattice,
+                &rest.muscles,
+                knee,
+                bones,
+                sim.config.tissue.clone(),
+            )?);
+        }
         if sim.config.initial_knee_deg != 0.0 {
             sim.set_knee(sim.config.initial_knee_deg.to_radians(), 0.0)?;
         }
         Ok(sim)
+    }
+
+    /// Lets the muscle chains settle at rest: a chain drawn along a curved muscle
+    /// straightens a little under its passive tension and sags under gravity, and the
+    /// tissue takes that equilibrium as its rest shape rather than showing the settling
+    /// as deformation. The skeleton is put back where it was; the clock stays at 0.
+    fn settle(&mut self) {
+        let skeleton = self.skeleton.clone();
+        let muscles = self.muscles.clone();
+        let h = self.config.max_step_s;
+        let n = (SETTLE_S / h).ceil() as usize;
+        for _ in 0..n {
+            self.substep(h);
+            if self.non_finite().is_some() {
+                // A model that cannot rest (absurd muscle parameters) starts unsettled;
+                // stepping will report it.
+                self.muscles = muscles;
+                break;
+            }
+        }
+        self.skeleton = skeleton;
+        self.frames = self.current_frames();
+        for m in &mut self.muscles {
+            m.chain.v.iter_mut().for_each(|v| *v = Vec3::ZERO);
+            m.chain.attach_ends(&self.frames);
+            m.chain.update_wrap();
+            m.path_length = m.chain.path_length();
+            m.path_velocity = 0.0;
+        }
+        (self.time, self.steps, self.knee_torque) = (0.0, 0, 0.0);
     }
 
     /// The built-in phantom with the default lattice options and muscle catalogue.
