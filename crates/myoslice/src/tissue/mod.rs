@@ -324,8 +324,8 @@ impl Tissue {
                 .push((v as u32, shape.current[mv as usize] + turn * offset));
         }
         // First guess, from the fold (so nothing accumulates): each radial column of
-        // vertices moves with its inner vertex where that follows a muscle, keeping the
-        // fat's thickness; part of the last update's correction is carried over (inertia
+        // vertices moves with its inner vertex where that follows a muscle, the skin by
+        // half as much; part of the last update's correction is carried over (inertia
         // with damping).
         let momentum = self.config.momentum as f32;
         let lat = &lattice.fat;
