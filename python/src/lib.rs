@@ -8,6 +8,7 @@ use glam::Vec3;
 use myoslice::muscle::MuscleCatalogue;
 use myoslice::prelude::*;
 use myoslice::simulation::{Layer, SimulationState};
+use myoslice::tissue::TissueMetrics;
 use myoslice_viewer::capture::{CaptureOptions, Offscreen};
 use myoslice_viewer::{CameraPreset, ColorMode, Gpu};
 use numpy::ndarray::Array2;
@@ -137,6 +138,19 @@ fn config(
     c.tissue.rate_hz = tissue_rate_hz;
     c.validate().or_py(py)?;
     Ok(c)
+}
+
+/// A per-element or per-muscle tissue metric as a float32 array (empty without tissue).
+fn metric_array<'py>(
+    py: Python<'py>,
+    sim: &Simulation,
+    pick: impl Fn(&TissueMetrics) -> &Vec<f32>,
+) -> Bound<'py, PyArray1<f32>> {
+    PyArray1::from_vec(
+        py,
+        sim.tissue_metrics()
+            .map_or_else(Vec::new, |m| pick(m).clone()),
+    )
 }
 
 fn check_path(py: Python<'_>, p: &Path, what: &str) -> PyResult<()> {
@@ -487,45 +501,25 @@ impl PySimulation {
     /// Area change A/A0 − 1 of each fat element's outer face (float32; empty without tissue).
     #[getter]
     fn area_change<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f32>> {
-        PyArray1::from_vec(
-            py,
-            self.sim
-                .tissue_metrics()
-                .map_or_else(Vec::new, |m| m.area_change.clone()),
-        )
+        metric_array(py, &self.sim, |m| &m.area_change)
     }
 
     /// Deformation degree (paper Eq. 5, m) of each fat element (float32; empty without tissue).
     #[getter]
     fn deformation_degree<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f32>> {
-        PyArray1::from_vec(
-            py,
-            self.sim
-                .tissue_metrics()
-                .map_or_else(Vec::new, |m| m.deformation_degree.clone()),
-        )
+        metric_array(py, &self.sim, |m| &m.deformation_degree)
     }
 
     /// Volume over rest volume of each fat element (float32; empty without tissue).
     #[getter]
     fn volume_ratio<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f32>> {
-        PyArray1::from_vec(
-            py,
-            self.sim
-                .tissue_metrics()
-                .map_or_else(Vec::new, |m| m.volume_ratio.clone()),
-        )
+        metric_array(py, &self.sim, |m| &m.volume_ratio)
     }
 
     /// Volume over rest volume of each muscle (float32; empty without tissue).
     #[getter]
     fn muscle_volume_ratio<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f32>> {
-        PyArray1::from_vec(
-            py,
-            self.sim
-                .tissue_metrics()
-                .map_or_else(Vec::new, |m| m.muscle_volume_ratio.clone()),
-        )
+        metric_array(py, &self.sim, |m| &m.muscle_volume_ratio)
     }
 
     /// Number of fat elements (hexahedra).

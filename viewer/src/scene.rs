@@ -5,7 +5,7 @@ use std::ops::Range;
 
 use glam::Vec3;
 use myoslice::Simulation;
-use myoslice::body::{BodyId, body_of_bone};
+use myoslice::body::BodyId;
 
 use crate::colormap::{self, ColorMode};
 
@@ -109,19 +109,13 @@ impl SceneMesh {
         let mut s = SceneMesh::default();
         let lat = sim.lattice();
         let frames = sim.frames();
-        // Bones, moved with their bodies.
+        // Bones, moved with their bodies (also framed when hidden).
+        let bones: Vec<Vec<Vec3>> = (0..lat.bones.len()).map(|i| sim.bone_vertices(i)).collect();
         let start = s.indices.len() as u32;
         if opts.visible[0] {
             let c = colormap::BONE;
-            for b in &lat.bones {
-                let body = body_of_bone(&b.name);
-                let v: Vec<Vec3> = b
-                    .mesh
-                    .vertices
-                    .iter()
-                    .map(|p| frames.point(body, *p))
-                    .collect();
-                s.push_mesh(&v, &b.mesh.triangles, [c[0], c[1], c[2], opts.opacity[0]]);
+            for (b, v) in lat.bones.iter().zip(&bones) {
+                s.push_mesh(v, &b.mesh.triangles, [c[0], c[1], c[2], opts.opacity[0]]);
             }
         }
         s.ranges[0] = start..s.indices.len() as u32;
@@ -209,10 +203,7 @@ impl SceneMesh {
         s.ranges[2] = start..s.indices.len() as u32;
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
         // The posed bones and skin, and whatever else is drawn (muscles may reach past both).
-        let posed_bones = lat.bones.iter().flat_map(|b| {
-            let body = body_of_bone(&b.name);
-            b.mesh.vertices.iter().map(move |p| frames.point(body, *p))
-        });
+        let posed_bones = bones.iter().flatten().copied();
         let drawn = s.vertices.iter().map(|v| Vec3::from_array(v.pos));
         for p in fat_x.iter().copied().chain(posed_bones).chain(drawn) {
             lo = lo.min(p);

@@ -156,21 +156,10 @@ impl RunWriter {
                 ];
             }
         }
-        let fat_x: Vec<Vec3> = sim
-            .tissue()
-            .map_or_else(|| lat.fat.vertices.clone(), |t| t.fat_vertices().to_vec());
+        let fat_x: Vec<Vec3> = sim.fat_vertices().to_vec();
         if self.outputs.vtu {
-            let bones: Vec<Vec<Vec3>> = lat
-                .bones
-                .iter()
-                .map(|b| {
-                    b.mesh
-                        .vertices
-                        .iter()
-                        .map(|p| frames.point(body_of_bone(&b.name), *p))
-                        .collect()
-                })
-                .collect();
+            let bones: Vec<Vec<Vec3>> =
+                (0..lat.bones.len()).map(|i| sim.bone_vertices(i)).collect();
             let muscles: Vec<Vec<Vec3>> = match sim.tissue() {
                 Some(t) => t.muscles.iter().map(|m| m.current.clone()).collect(),
                 None => sim

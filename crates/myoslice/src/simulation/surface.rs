@@ -89,6 +89,17 @@ impl FatLattice {
 }
 
 impl Simulation {
+    /// Vertices of bone `i` (lattice order) now, moved with its body.
+    pub fn bone_vertices(&self, i: usize) -> Vec<Vec3> {
+        let b = &self.lattice().bones[i];
+        let body = body_of_bone(&b.name);
+        b.mesh
+            .vertices
+            .iter()
+            .map(|p| self.frames().point(body, *p))
+            .collect()
+    }
+
     /// Vertices of muscle `i` (simulation order) now: its deformed shape, or without
     /// tissue its rest shape carried by its origin bone.
     pub fn muscle_vertices(&self, i: usize) -> Vec<Vec3> {
@@ -128,15 +139,8 @@ impl Simulation {
         let mut s = Surface::default();
         match layer {
             Layer::Bone => {
-                for b in &lat.bones {
-                    let body = body_of_bone(&b.name);
-                    let v: Vec<Vec3> = b
-                        .mesh
-                        .vertices
-                        .iter()
-                        .map(|p| self.frames().point(body, *p))
-                        .collect();
-                    s.push(&v, &b.mesh.triangles);
+                for (i, b) in lat.bones.iter().enumerate() {
+                    s.push(&self.bone_vertices(i), &b.mesh.triangles);
                 }
             }
             Layer::Muscle => {
