@@ -38,6 +38,23 @@ pub fn scratch(name: &str) -> PathBuf {
     d
 }
 
+/// The number, or array of numbers, under `key` in a flat JSON object (the viewer's
+/// capture metadata); empty when the key is absent or not numeric.
+pub fn json_numbers(json: &str, key: &str) -> Vec<f32> {
+    let pat = format!("\"{key}\":");
+    let Some(at) = json.find(&pat) else {
+        return Vec::new();
+    };
+    let rest = json[at + pat.len()..].trim_start();
+    let body = match rest.strip_prefix('[') {
+        Some(r) => r.split(']').next().unwrap_or(""),
+        None => rest.split([',', '}']).next().unwrap_or(""),
+    };
+    body.split(',')
+        .map_while(|v| v.trim().parse().ok())
+        .collect()
+}
+
 /// An RGB image.
 #[derive(Debug, Clone)]
 pub struct Image {

@@ -4,7 +4,7 @@
 
 use std::process::Command;
 
-use myoslice_e2e::{Image, binary, read_png, root, scratch};
+use myoslice_e2e::{Image, binary, json_numbers, read_png, root, scratch};
 
 fn capture(args: &[&str], name: &str) -> Image {
     capture_to(args, &scratch(name).join("out.png"))
@@ -35,10 +35,15 @@ fn is_background(p: &[u8]) -> bool {
 /// Counts pixels of the leg (not background) that are blue-ish, red-ish and white-ish,
 /// excluding the legend strip at the right edge.
 fn classify(img: &Image) -> (usize, usize, usize, usize) {
+    classify_where(img, |_, _| true)
+}
+
+/// As [`classify`], over the pixels (x, y) that `keep` accepts.
+fn classify_where(img: &Image, keep: impl Fn(f32, f32) -> bool) -> (usize, usize, usize, usize) {
     let (mut leg, mut blue, mut red, mut white) = (0, 0, 0, 0);
     let legend_x = (img.width as f32 * 0.9) as u32;
     for y in 0..img.height {
-        for x in 0..legend_x {
+        for x in (0..legend_x).filter(|&x| keep(x as f32, y as f32)) {
             let i = 3 * (y * img.width + x) as usize;
             let p = &img.rgb[i..i + 3];
             if is_background(p) {
@@ -91,13 +96,42 @@ fn area_colours_after_a_flexion_show_growth_and_shrinkage_and_none_shows_neither
         "--layers",
         "skin",
     ];
-    let area = capture(&[&args[..], &["--color", "area"]].concat(), "area");
-    let (leg, blue, red, white) = classify(&area);
-    assert!(blue > 30, "blue-ish (grown) pixels: {blue} of {leg}");
-    assert!(red > 30, "red-ish (shrunk) pixels: {red} of {leg}");
+    let dir = scratch("area");
+    let meta = dir.join("meta.json");
+    let area = capture_to(
+        &[
+            &args[..],
+            &["--color", "area", "--meta", meta.to_str().unwrap()],
+        ]
+        .concat(),
+        &dir.join("out.png"),
+    );
+    // Where the knee is in the picture, as the capture reports it.
+    let json = std::fs::read_to_string(&meta).unwrap();
+    let number = |key: &str| json_numbers(&json, key);
+    let (knee, px_per_m) = (number("knee_px"), number("px_per_m")[0]);
+    assert_eq!(knee.len(), 2, "{json}");
     assert!(
-        white > leg / 10,
-        "white-ish (unchanged) pixels: {white} of {leg}"
+        number("knee_angle_deg")[0] > 20.0,
+        "the knee has flexed: {json}"
+    );
+    let dist_m = |x: f32, y: f32| (x - knee[0]).hypot(y - knee[1]) / px_per_m;
+    // Near the knee (10 cm): the surface grew somewhere and shrank somewhere.
+    let (near, blue, red, _) = classify_where(&area, |x, y| dist_m(x, y) < 0.10);
+    assert!(
+        blue > 30,
+        "blue-ish (grown) pixels near the knee: {blue} of {near}"
+    );
+    assert!(
+        red > 30,
+        "red-ish (shrunk) pixels near the knee: {red} of {near}"
+    );
+    // Away from it (beyond 15 cm) thigh and shank are nearly unchanged: white-ish.
+    let (far, blue, red, white) = classify_where(&area, |x, y| dist_m(x, y) > 0.15);
+    assert!(far > 1000, "the leg away from the knee: {far} pixels");
+    assert!(
+        white * 4 > far * 3 && (blue + red) * 100 < far * 3,
+        "away from the knee: white {white}, blue {blue}, red {red} of {far}"
     );
     let none = capture(&[&args[..], &["--color", "none"]].concat(), "none");
     let (leg, blue, red, _) = classify(&none);

@@ -14,9 +14,13 @@ use winit::window::{Window, WindowId};
 use crate::camera::{CameraPreset, OrbitCamera};
 use crate::gpu::Gpu;
 use crate::model::ModelSource;
+use crate::pick::{Ray, pick_muscle};
 use crate::render::{DEPTH, RenderSettings, Renderer};
 use crate::scene::{SceneMesh, SceneOptions};
 use crate::ui::{UiAction, UiState};
+
+/// How far (px) the pointer may move between press and release and still be a click.
+const CLICK_SLOP_PX: f64 = 4.0;
 
 /// Opens the window on a model (or a scenario) and runs until it is closed.
 pub fn run(source: ModelSource, scenario: Option<PathBuf>) -> Result<()> {
@@ -48,6 +52,8 @@ pub fn run(source: ModelSource, scenario: Option<PathBuf>) -> Result<()> {
         scenario,
         camera: None,
         drag: None,
+        cursor: None,
+        press: None,
         last: Instant::now(),
         fatal: None,
     };
@@ -89,6 +95,10 @@ struct App {
     scenario: Option<PathBuf>,
     camera: Option<OrbitCamera>,
     drag: Option<(MouseButton, (f64, f64))>,
+    /// Last cursor position in the window (px).
+    cursor: Option<(f64, f64)>,
+    /// Where the left button went down, and the muscle under it then.
+    press: Option<((f64, f64), Option<usize>)>,
     last: Instant,
     fatal: Option<anyhow::Error>,
 }
@@ -182,16 +192,6 @@ impl App {
         Ok(())
     }
 
-    fn scene_options(&self) -> SceneOptions {
-        SceneOptions {
-            color_mode: self.ui.color_mode,
-            visible: self.ui.visible,
-            opacity: self.ui.opacity,
-            selected_muscle: self.ui.selected,
-            ..SceneOptions::default()
-        }
-    }
-
     fn advance(&mut self) {
         let now = Instant::now();
         let real = now.duration_since(self.last).as_secs_f64().min(0.1);
@@ -229,6 +229,8 @@ impl App {
                 UiAction::Load(src) => match load(&src, None) {
                     Ok(s) => {
                         self.sim = s;
+                        self.ui.selected = None;
+                        self.ui.hovered = None;
                         self.ui.source = src;
                         self.scenario = None;
                         self.ui.default_plot(&self.sim);
@@ -302,14 +304,7 @@ impl App {
         let view = frame
             .texture
             .create_view(&wgpu::TextureViewDescriptor::default());
-        let opts = SceneOptions {
-            color_mode: self.ui.color_mode,
-            visible: self.ui.visible,
-            opacity: self.ui.opacity,
-            selected_muscle: self.ui.selected,
-            ..SceneOptions::default()
-        };
-        let scene = SceneMesh::build(&self.sim, &opts);
+        let scene = SceneMesh::build(&self.sim, &self.ui.scene_options());
         self.ui.color_range = scene.color_range;
         let aspect = g.config.width as f32 / g.config.height.max(1) as f32;
         let camera = *self.camera.get_or_insert_with(|| {
@@ -320,6 +315,18 @@ impl App {
                 aspect,
             )
         });
+        // What the cursor is over, for the next frame's tint and tooltip (not while the
+        // camera is dragged or the pointer is on the panel).
+        let over_egui = g.egui_ctx.is_pointer_over_egui();
+        let moving_camera = self.drag.is_some_and(|(_, last)| last.0.is_finite());
+        self.ui.hovered = match self.cursor {
+            Some((x, y)) if self.ui.visible[1] && !over_egui && !moving_camera => {
+                let size = glam::Vec2::new(g.config.width as f32, g.config.height as f32);
+                let ray = Ray::through_pixel(&camera, glam::Vec2::new(x as f32, y as f32), size);
+                pick_muscle(&scene, &ray)
+            }
+            _ => None,
+        };
         let mut enc = g
             .gpu
             .device
@@ -373,7 +380,6 @@ impl App {
         g.window.pre_present_notify();
         g.gpu.queue.present(frame);
         self.act(actions);
-        let _ = self.scene_options();
     }
 }
 
@@ -403,12 +409,28 @@ impl ApplicationHandler for App {
             }
             WindowEvent::RedrawRequested => self.redraw(),
             WindowEvent::MouseInput { state, button, .. } if !resp.consumed => {
+                // A left click that barely moved picks a muscle; a drag moves the camera.
+                match (state, button) {
+                    (ElementState::Pressed, MouseButton::Left) if !egui_wants => {
+                        self.press = self.cursor.map(|c| (c, self.ui.hovered));
+                    }
+                    (ElementState::Released, MouseButton::Left) => {
+                        if let (Some((p, picked)), Some(c)) = (self.press.take(), self.cursor)
+                            && (p.0 - c.0).hypot(p.1 - c.1) < CLICK_SLOP_PX
+                        {
+                            self.ui.click(picked);
+                        }
+                    }
+                    _ => {}
+                }
                 self.drag = match state {
                     ElementState::Pressed if !egui_wants => Some((button, (f64::NAN, f64::NAN))),
                     _ => None,
                 };
             }
+            WindowEvent::CursorLeft { .. } => self.cursor = None,
             WindowEvent::CursorMoved { position, .. } => {
+                self.cursor = Some((position.x, position.y));
                 if let (Some((button, last)), Some(cam)) =
                     (self.drag.as_mut(), self.camera.as_mut())
                 {

@@ -117,10 +117,7 @@ impl Offscreen {
         opts: &CaptureOptions,
     ) -> Result<Vec<u8>> {
         let scene = SceneMesh::build(sim, &opts.scene);
-        let aspect = opts.width as f32 / opts.height.max(1) as f32;
-        let camera = opts.fixed_camera.unwrap_or_else(|| {
-            OrbitCamera::framing(scene.bounds.0, scene.bounds.1, opts.camera, aspect)
-        });
+        let camera = camera_for(&scene, opts);
         let mut enc = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
@@ -145,6 +142,77 @@ impl Offscreen {
             &settings,
         );
         read_rgba(gpu, enc, &self.color)
+    }
+}
+
+/// The camera a capture of `scene` uses: the fixed one, or one framing the scene.
+fn camera_for(scene: &SceneMesh, opts: &CaptureOptions) -> OrbitCamera {
+    let aspect = opts.width as f32 / opts.height.max(1) as f32;
+    opts.fixed_camera.unwrap_or_else(|| {
+        OrbitCamera::framing(scene.bounds.0, scene.bounds.1, opts.camera, aspect)
+    })
+}
+
+/// What a capture shows, for annotating or checking it: where the knee lies in the
+/// picture and at what angle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CaptureMeta {
+    /// Picture size (pixels).
+    pub size: [u32; 2],
+    /// Simulated time (s).
+    pub time: f64,
+    /// Knee flexion (degrees).
+    pub knee_angle_deg: f64,
+    /// The knee axis's centre in the picture (pixels from the top-left corner).
+    pub knee_px: [f32; 2],
+    /// Pixels per metre at the knee's depth (to size regions around it).
+    pub px_per_m: f32,
+}
+
+impl CaptureMeta {
+    /// The metadata of a capture of `sim` now with `opts`.
+    pub fn of(sim: &Simulation, opts: &CaptureOptions) -> Self {
+        let scene = SceneMesh::build(sim, &opts.scene);
+        let camera = camera_for(&scene, opts);
+        let (w, h) = (opts.width as f32, opts.height.max(1) as f32);
+        let vp = camera.projection(w / h) * camera.view();
+        let knee = sim.knee_axis().point;
+        let to_px = |p: glam::Vec3| {
+            let clip = vp * p.extend(1.0);
+            let ndc = clip.truncate() / clip.w;
+            [(ndc.x + 1.0) * 0.5 * w, (1.0 - ndc.y) * 0.5 * h]
+        };
+        let k = to_px(knee);
+        // A 10 cm step across the view at the knee's depth.
+        let view = camera.view();
+        let right = glam::Vec3::new(view.x_axis.x, view.y_axis.x, view.z_axis.x);
+        let r = to_px(knee + right * 0.1);
+        Self {
+            size: [opts.width, opts.height],
+            time: sim.time(),
+            knee_angle_deg: sim.knee_angle().to_degrees(),
+            knee_px: k,
+            px_per_m: (r[0] - k[0]).hypot(r[1] - k[1]) / 0.1,
+        }
+    }
+
+    /// As a JSON object.
+    pub fn to_json(&self) -> String {
+        format!(
+            "{{\"width\": {}, \"height\": {}, \"time_s\": {:?}, \"knee_angle_deg\": {:?}, \"knee_px\": [{:?}, {:?}], \"px_per_m\": {:?}}}\n",
+            self.size[0],
+            self.size[1],
+            self.time,
+            self.knee_angle_deg,
+            self.knee_px[0],
+            self.knee_px[1],
+            self.px_per_m
+        )
+    }
+
+    /// Writes the JSON to `path`.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        std::fs::write(path, self.to_json()).with_context(|| format!("writing {}", path.display()))
     }
 }
 

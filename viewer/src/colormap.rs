@@ -29,6 +29,10 @@ pub const SKIN: [f32; 3] = [0.93, 0.76, 0.64];
 pub const BONE: [f32; 3] = [0.93, 0.91, 0.84];
 /// Muscle colour.
 pub const MUSCLE: [f32; 3] = [0.62, 0.18, 0.14];
+/// The muscle under the cursor: the same red, lighter, so it reads as the same tissue.
+pub const HOVERED: [f32; 3] = [0.92, 0.42, 0.32];
+/// The selected muscle: gold, apart from every tissue colour.
+pub const SELECTED: [f32; 3] = [0.98, 0.78, 0.15];
 
 fn lerp3(a: [f32; 3], b: [f32; 3], t: f32) -> [f32; 3] {
     let t = t.clamp(0.0, 1.0);

@@ -6,6 +6,7 @@ pub mod capture;
 pub mod colormap;
 pub mod gpu;
 pub mod model;
+pub mod pick;
 pub mod render;
 pub mod scene;
 
@@ -18,5 +19,6 @@ pub use camera::{CameraPreset, OrbitCamera};
 pub use capture::{CaptureOptions, capture_frames, capture_png};
 pub use colormap::ColorMode;
 pub use gpu::{Gpu, GpuError};
+pub use pick::{Ray, pick_muscle};
 pub use render::{RenderSettings, Renderer};
 pub use scene::{Layer, SceneMesh};

@@ -7,7 +7,7 @@ use anyhow::{Context, Result, anyhow};
 use clap::Parser;
 use myoslice::prelude::*;
 use myoslice_viewer::camera::CameraPreset;
-use myoslice_viewer::capture::{CaptureOptions, advance, capture_frames, capture_png};
+use myoslice_viewer::capture::{CaptureMeta, CaptureOptions, advance, capture_frames, capture_png};
 use myoslice_viewer::colormap::ColorMode;
 use myoslice_viewer::model::{ModelSource, Preset};
 use myoslice_viewer::scene::SceneOptions;
@@ -68,6 +68,9 @@ struct Args {
     /// No colour-bar legend in captures.
     #[arg(long)]
     no_legend: bool,
+    /// Also write what the PNG shows (time, knee angle, the knee's pixel) as JSON here.
+    #[arg(long, requires = "capture")]
+    meta: Option<PathBuf>,
 }
 
 fn build(args: &Args) -> Result<Simulation> {
@@ -169,6 +172,7 @@ fn capture(args: &Args) -> Result<()> {
         )?;
         if let Some(p) = &args.capture {
             capture_png(&gpu, &sim, &opts, p)?;
+            write_meta(args, &sim, &opts)?;
         }
         return Ok(());
     }
@@ -180,7 +184,14 @@ fn capture(args: &Args) -> Result<()> {
         .as_ref()
         .context("--capture needs an output path")?;
     capture_png(&gpu, &sim, &opts, path)?;
-    Ok(())
+    write_meta(args, &sim, &opts)
+}
+
+fn write_meta(args: &Args, sim: &Simulation, opts: &CaptureOptions) -> Result<()> {
+    match &args.meta {
+        Some(p) => CaptureMeta::of(sim, opts).write(p),
+        None => Ok(()),
+    }
 }
 
 fn main() -> ExitCode {

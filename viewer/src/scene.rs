@@ -43,6 +43,8 @@ pub struct SceneOptions {
     pub opacity: [f32; 3],
     /// Muscle highlighted (index in the simulation's muscle order).
     pub selected_muscle: Option<usize>,
+    /// Muscle under the cursor, tinted lighter.
+    pub hovered_muscle: Option<usize>,
     /// Half-width of the area-change scale in log2(A/A0) (None: 1, i.e. ×2 and ×½).
     pub area_range: Option<f32>,
     /// Fixed scale for deformation degree, m (None: from the data).
@@ -56,6 +58,7 @@ impl Default for SceneOptions {
             visible: [true, true, true],
             opacity: [1.0, 1.0, 0.45],
             selected_muscle: None,
+            hovered_muscle: None,
             area_range: None,
             degree_range: None,
         }
@@ -71,6 +74,9 @@ pub struct SceneMesh {
     pub indices: Vec<u32>,
     /// Index range of each layer (bone, muscle, skin).
     pub ranges: [Range<u32>; 3],
+    /// Index range of each drawn muscle, with its index in the simulation's order,
+    /// ascending (for picking).
+    pub muscle_ranges: Vec<(usize, Range<u32>)>,
     /// Bounding box of everything.
     pub bounds: (Vec3, Vec3),
     /// Scale used for the surface colours (log2 area ratio, or degree in m).
@@ -125,12 +131,16 @@ impl SceneMesh {
             for (i, m) in sim.muscles().iter().enumerate() {
                 let lm = &lat.muscles[m.lattice_index];
                 let c = if opts.selected_muscle == Some(i) {
-                    [0.98, 0.78, 0.15]
+                    colormap::SELECTED
+                } else if opts.hovered_muscle == Some(i) {
+                    colormap::HOVERED
                 } else {
                     colormap::MUSCLE
                 };
                 let color = [c[0], c[1], c[2], opts.opacity[1]];
+                let from = s.indices.len() as u32;
                 s.push_mesh(&sim.muscle_vertices(i), &lm.mesh.triangles, color);
+                s.muscle_ranges.push((i, from..s.indices.len() as u32));
             }
         }
         s.ranges[1] = start..s.indices.len() as u32;
@@ -213,6 +223,15 @@ impl SceneMesh {
         s
     }
 
+    /// The muscle whose triangles include index position `at` (into `indices`).
+    pub fn muscle_of_index(&self, at: u32) -> Option<usize> {
+        let k = self.muscle_ranges.partition_point(|(_, r)| r.end <= at);
+        self.muscle_ranges
+            .get(k)
+            .filter(|(_, r)| r.contains(&at))
+            .map(|(i, _)| *i)
+    }
+
     /// Triangle count of a layer.
     pub fn triangles(&self, layer: Layer) -> usize {
         self.ranges[layer as usize].len() / 3
@@ -278,6 +297,38 @@ mod tests {
         };
         assert!(skin_colours(ColorMode::Area) > 100);
         assert_eq!(skin_colours(ColorMode::None), 0);
+    }
+
+    #[test]
+    fn the_hovered_and_selected_muscles_are_tinted_and_their_triangles_map_back_to_them() {
+        let mut config = SimulationConfig::default();
+        config.tissue.enabled = false;
+        let sim = Simulation::phantom(config).expect("phantom");
+        let (hov, sel) = (2, 5);
+        let m = SceneMesh::build(
+            &sim,
+            &SceneOptions {
+                hovered_muscle: Some(hov),
+                selected_muscle: Some(sel),
+                ..SceneOptions::default()
+            },
+        );
+        assert_eq!(m.muscle_ranges.len(), sim.muscles().len());
+        for (i, r) in &m.muscle_ranges {
+            let want = match *i {
+                i if i == sel => colormap::SELECTED,
+                i if i == hov => colormap::HOVERED,
+                _ => colormap::MUSCLE,
+            };
+            for &k in &m.indices[r.start as usize..r.end as usize] {
+                assert_eq!(m.vertices[k as usize].color[..3], want[..], "muscle {i}");
+            }
+            assert_eq!(m.muscle_of_index(r.start), Some(*i));
+            assert_eq!(m.muscle_of_index(r.end - 1), Some(*i));
+        }
+        // Bone and skin indices belong to no muscle.
+        assert_eq!(m.muscle_of_index(m.ranges[0].start), None);
+        assert_eq!(m.muscle_of_index(m.ranges[2].start), None);
     }
 
     #[test]

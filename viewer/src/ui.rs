@@ -10,6 +10,7 @@ use myoslice::muscle::MuscleGroup;
 use crate::camera::CameraPreset;
 use crate::colormap::{self, ColorMode};
 use crate::model::{ModelSource, Preset};
+use crate::scene::SceneOptions;
 
 /// Samples kept for the live plot.
 pub const HISTORY: usize = 600;
@@ -83,6 +84,8 @@ pub struct UiState {
     pub opacity: [f32; 3],
     /// Highlighted muscle.
     pub selected: Option<usize>,
+    /// Muscle under the cursor in the 3D view.
+    pub hovered: Option<usize>,
     /// Muscles in the force plot.
     pub plotted: Vec<usize>,
     /// Live plot data.
@@ -112,6 +115,7 @@ impl Default for UiState {
             visible: [true, true, true],
             opacity: [1.0, 1.0, 0.45],
             selected: None,
+            hovered: None,
             plotted: Vec::new(),
             history: History::default(),
             error: None,
@@ -145,6 +149,39 @@ impl UiState {
             .flatten()
             .collect();
         self.history.clear();
+    }
+
+    /// What the 3D view draws, from the panel's settings.
+    pub fn scene_options(&self) -> SceneOptions {
+        SceneOptions {
+            color_mode: self.color_mode,
+            visible: self.visible,
+            opacity: self.opacity,
+            selected_muscle: self.selected,
+            hovered_muscle: self.hovered,
+            ..SceneOptions::default()
+        }
+    }
+
+    /// A click in the 3D view on `picked` (None: empty space): selects that muscle, or
+    /// clears the selection when it was already selected or nothing was hit.
+    pub fn click(&mut self, picked: Option<usize>) {
+        self.selected = if picked == self.selected {
+            None
+        } else {
+            picked
+        };
+    }
+
+    /// The tooltip of the muscle under the cursor: name, force and knee moment arm.
+    pub fn hover_text(&self, sim: &Simulation) -> Option<String> {
+        let m = sim.muscles().get(self.hovered?)?;
+        let mut text = format!("{}\n{:.0} N", m.name.replace('_', " "), m.force);
+        if m.crosses_knee {
+            text += &format!(", moment arm {:+.1} cm", m.moment_arm * 100.0);
+        }
+        text += "\nclick to select";
+        Some(text)
     }
 
     /// Records the simulation's state for the plot.
@@ -182,6 +219,17 @@ impl UiState {
                 });
             });
         let ctx = ui.ctx().clone();
+        if let (Some(text), Some(pos)) =
+            (self.hover_text(sim), ctx.input(|i| i.pointer.hover_pos()))
+        {
+            egui::Area::new(egui::Id::unique("hovered muscle"))
+                .order(egui::Order::Tooltip)
+                .interactable(false)
+                .fixed_pos(pos + egui::vec2(16.0, 16.0))
+                .show(&ctx, |ui| {
+                    egui::Frame::popup(ui.style()).show(ui, |ui| ui.label(text));
+                });
+        }
         let mut close = false;
         if let Some(msg) = &self.error {
             egui::Window::new("Error")
@@ -462,6 +510,7 @@ impl UiState {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use myoslice::SimulationConfig;
 
     #[test]
     fn the_ui_has_glyphs_for_every_character_of_its_labels() {
@@ -480,6 +529,40 @@ mod tests {
             .filter(|c| !ctx.fonts_mut(|f| f.has_glyph(&font, *c)))
             .collect();
         assert!(missing.is_empty(), "no glyph for {missing:?}");
+    }
+
+    #[test]
+    fn clicking_a_muscle_selects_it_and_clicking_it_again_or_on_nothing_clears() {
+        let mut ui = UiState::default();
+        ui.click(Some(3));
+        assert_eq!(ui.selected, Some(3));
+        ui.click(Some(5));
+        assert_eq!(ui.selected, Some(5));
+        ui.click(Some(5));
+        assert_eq!(ui.selected, None);
+        ui.click(Some(2));
+        ui.click(None);
+        assert_eq!(ui.selected, None);
+    }
+
+    #[test]
+    fn the_hover_tooltip_names_the_muscle_with_its_force_and_moment_arm() {
+        let mut config = SimulationConfig::default();
+        config.tissue.enabled = false;
+        let sim = Simulation::phantom(config).expect("phantom");
+        let mut ui = UiState::default();
+        assert_eq!(ui.hover_text(&sim), None);
+        let st = sim.muscle_index("semitendinosus").expect("semitendinosus");
+        ui.hovered = Some(st);
+        let text = ui.hover_text(&sim).expect("a tooltip");
+        assert!(text.starts_with("semitendinosus\n"), "{text}");
+        assert!(
+            text.contains("moment arm +"),
+            "a flexor's arm is positive: {text}"
+        );
+        // A stale index (after loading a smaller model) shows nothing rather than panicking.
+        ui.hovered = Some(sim.muscles().len());
+        assert_eq!(ui.hover_text(&sim), None);
     }
 
     #[test]

@@ -314,41 +314,96 @@ fn activation_rises_and_falls_with_the_published_time_constants() {
     assert!((0.005..0.03).contains(&t63), "63% activation after {t63} s");
 }
 
+/// Force-weighted moment arm (m) of a muscle group at `deg` of flexion: the group's
+/// effective lever.
+fn group_moment_arm(base: &Simulation, names: &[&str], deg: f64) -> f64 {
+    let mut s = base.clone();
+    s.set_knee(deg.to_radians(), 0.0).unwrap();
+    let (mut num, mut den) = (0.0, 0.0);
+    for m in names {
+        let i = s.muscle_index(m).unwrap();
+        let f = s.muscles()[i].hill.max_isometric_force;
+        num += f * s.muscle(m).unwrap().moment_arm;
+        den += f;
+    }
+    num / den
+}
+
 #[test]
 fn moment_arms_lie_in_published_human_ranges() {
+    // Published knee moment arms (e.g. Buford et al. 1997, Herzog & Read 1993, Spoor &
+    // van Leeuwen 1992): hamstrings about 2-4 cm, quadriceps 3-5 cm. Known weakness, kept
+    // visible: with a fixed flexion axis (no femoral roll-back) the hamstring lever falls
+    // to about 1.6 cm at 120°, so that angle has its own lower bound.
     let base = sim(config());
-    let group = |names: &[&str], deg: f64| -> f64 {
-        let mut s = base.clone();
-        s.set_knee(deg.to_radians(), 0.0).unwrap();
-        for m in names {
-            s.set_excitation(m, 0.2).unwrap();
-        }
-        s.step(0.002).unwrap();
-        // Weighted by maximal force: the group's effective lever.
-        let (mut num, mut den) = (0.0, 0.0);
-        for m in names {
-            let i = s.muscle_index(m).unwrap();
-            let f = s.muscles()[i].hill.max_isometric_force;
-            num += f * s.muscle(m).unwrap().moment_arm;
-            den += f;
-        }
-        num / den
-    };
     let mut report = String::new();
     for deg in [0.0, 30.0, 60.0, 90.0, 120.0] {
-        let flex = group(&HAMSTRINGS, deg) * 100.0;
-        let ext = -group(&QUADRICEPS, deg) * 100.0;
+        let flex = group_moment_arm(&base, &HAMSTRINGS, deg) * 100.0;
+        let ext = -group_moment_arm(&base, &QUADRICEPS, deg) * 100.0;
         report += &format!("{deg:>5.0}°: hamstrings {flex:.2} cm, quadriceps {ext:.2} cm\n");
+        let flex_low = if deg < 100.0 { 2.0 } else { 1.5 };
         assert!(
-            (1.5..=4.5).contains(&flex),
+            (flex_low..=4.5).contains(&flex),
             "hamstrings moment arm {flex:.2} cm at {deg}°\n{report}"
         );
         assert!(
-            (3.0..=5.5).contains(&ext),
+            (3.0..=5.0).contains(&ext),
             "quadriceps moment arm {ext:.2} cm at {deg}°\n{report}"
         );
     }
     println!("{report}");
+}
+
+#[test]
+fn moment_arms_equal_the_tendon_excursion() {
+    // Virtual work (the reported moment arm) against tendon excursion: turn the knee by
+    // ±0.5° with every chain point carried by its bone and difference the path lengths.
+    let base = sim(config());
+    let d = 0.5f64.to_radians();
+    for deg in [5.0, 30.0, 60.0, 90.0, 120.0] {
+        let mut at = base.clone();
+        at.set_knee(f64::to_radians(deg), 0.0).unwrap();
+        let (mut up, mut down) = (at.clone(), at.clone());
+        up.set_knee(f64::to_radians(deg) + d, 0.0).unwrap();
+        down.set_knee(f64::to_radians(deg) - d, 0.0).unwrap();
+        for (i, m) in at
+            .muscles()
+            .iter()
+            .enumerate()
+            .filter(|(_, m)| m.crosses_knee)
+        {
+            let excursion = -(up.readout(i).path_length - down.readout(i).path_length) / (2.0 * d);
+            let arm = at.readout(i).moment_arm;
+            assert!(
+                (arm - excursion).abs() <= 0.02 * excursion.abs() + 5e-4,
+                "{} at {deg}°: moment arm {arm:.4} m, excursion {excursion:.4} m",
+                m.name
+            );
+        }
+    }
+}
+
+#[test]
+fn knee_torque_is_tendon_force_times_moment_arm() {
+    let mut s = sim(config());
+    s.set_knee(40f64.to_radians(), 0.0).unwrap();
+    for m in HAMSTRINGS.iter().chain(&QUADRICEPS) {
+        s.set_excitation(m, 0.3).unwrap();
+    }
+    for _ in 0..50 {
+        s.step(0.001).unwrap();
+        let sum: f64 = (0..s.muscles().len())
+            .map(|i| {
+                let r = s.readout(i);
+                r.force * r.moment_arm
+            })
+            .sum();
+        let tau = s.knee_torque();
+        assert!(
+            (tau - sum).abs() <= 1e-3 * sum.abs().max(1.0),
+            "knee torque {tau} N m, sum of force × moment arm {sum} N m"
+        );
+    }
 }
 
 #[test]

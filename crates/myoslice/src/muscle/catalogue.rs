@@ -56,8 +56,7 @@ pub struct CatalogueEntry {
     /// Where on the origin bone the muscle attaches: `nearest` (default: the nearest
     /// surface point to the muscle's end), `superior` or `inferior` (its extreme point).
     pub origin_site: Option<String>,
-    /// Where on the insertion bone it attaches (as `origin_site`); the quadriceps tendon
-    /// inserts on the patella's base: `superior`.
+    /// Where on the insertion bone it attaches (as `origin_site`).
     pub insertion_site: Option<String>,
     /// The insertion lies at least this far (m) below the knee axis: the nearest point of
     /// the insertion bone to the muscle's end among those that low (hamstring and pes

@@ -531,25 +531,16 @@ impl MuscleChain {
             .sum();
     }
 
-    /// Forces the chain puts on its two bodies for the given loading. In Hill mode the
-    /// bones feel the tendon force `hill_force` along the end segments; in the paper's
-    /// mode they feel the full Eq. 1 segment force.
-    pub fn end_forces(&self, load: &ChainLoad, hill_force: Option<f32>) -> EndForces {
+    /// Forces the paper's chain puts on its two bodies: the full Eq. 1 force of the end
+    /// segments. (In Hill mode the tendon force acts through [`Self::pulls_on`] instead.)
+    pub fn end_forces(&self, load: &ChainLoad) -> EndForces {
         let n = self.x.len();
         let (g0, g1) = (self.segment(0), self.segment(n - 2));
-        match hill_force {
-            Some(t) => EndForces {
-                origin: g0.dir_a * t,
-                insertion: g1.dir_b * t,
-            },
-            None => {
-                let t0 = self.tension(0, &g0, load, 1.0, 0.0);
-                let t1 = self.tension(n - 2, &g1, load, 1.0, 0.0);
-                EndForces {
-                    origin: g0.dir_a * t0,
-                    insertion: g1.dir_b * t1,
-                }
-            }
+        let t0 = self.tension(0, &g0, load, 1.0, 0.0);
+        let t1 = self.tension(n - 2, &g1, load, 1.0, 0.0);
+        EndForces {
+            origin: g0.dir_a * t0,
+            insertion: g1.dir_b * t1,
         }
     }
 }

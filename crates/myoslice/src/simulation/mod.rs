@@ -18,7 +18,7 @@ use crate::error::{Error, Result, check_positive, check_range};
 use crate::lattice::{BuildOptions, Lattice};
 use crate::muscle::hill::activation_rate;
 use crate::muscle::{
-    BodyFrames, ChainLoad, ChainOptions, MuscleCatalogue, MuscleGroup, MuscleUnit,
+    Axis, BodyFrames, ChainLoad, ChainOptions, MuscleCatalogue, MuscleGroup, MuscleUnit,
 };
 use crate::tissue::{Tissue, TissueMetrics, bone_surfaces};
 
@@ -193,6 +193,10 @@ impl Simulation {
             m.path_length = m.chain.path_length();
             m.path_velocity = 0.0;
         }
+        let axis = self.knee_axis();
+        for m in self.muscles.iter_mut().filter(|m| m.crosses_knee) {
+            m.moment_arm = m.chain.moment_arm(&axis, BodyId::Shank);
+        }
         (self.time, self.steps, self.knee_torque) = (0.0, 0, 0.0);
     }
 
@@ -299,6 +303,15 @@ impl Simulation {
     /// Knee flexion angle (rad).
     pub fn knee_angle(&self) -> f64 {
         self.skeleton.knee_angle()
+    }
+
+    /// The knee's flexion axis in the world now (it turns with the thigh).
+    pub fn knee_axis(&self) -> Axis {
+        let knee = self.skeleton.knee();
+        Axis {
+            point: self.frames.point(BodyId::Thigh, knee.point),
+            dir: self.frames.vector(BodyId::Thigh, knee.axis),
+        }
     }
 
     /// Knee flexion velocity (rad/s).
@@ -432,6 +445,10 @@ impl Simulation {
             m.path_length = m.chain.path_length();
             m.path_velocity = 0.0;
         }
+        let axis = self.knee_axis();
+        for m in self.muscles.iter_mut().filter(|m| m.crosses_knee) {
+            m.moment_arm = m.chain.moment_arm(&axis, BodyId::Shank);
+        }
         if self.tissue.is_some() {
             // The fat follows a jump in a few relaxation passes.
             for _ in 0..4 {
@@ -515,6 +532,10 @@ impl Simulation {
         let frames = self.frames;
         let knee_point = frames.point(BodyId::Thigh, knee.point);
         let knee_dir = frames.vector(BodyId::Thigh, knee.axis);
+        let axis = Axis {
+            point: knee_point,
+            dir: knee_dir,
+        };
         let mut loads = Vec::with_capacity(self.muscles.len());
         for (m, sched) in self.muscles.iter_mut().zip(&self.schedules) {
             if let Some(s) = sched {
@@ -543,14 +564,7 @@ impl Simulation {
                     .rigid_tendon_kinematics(m.path_length, m.path_velocity);
                 let f = m.hill.force(m.activation, &m.fibre);
                 m.force = f.tendon;
-                let load = ChainLoad {
-                    contraction: f.tendon as f32,
-                    ..load
-                };
-                (
-                    f.tendon as f32,
-                    m.chain.end_forces(&load, Some(f.tendon as f32)),
-                )
+                (f.tendon as f32, None)
             } else {
                 m.activation = m.excitation;
                 let c = (m.excitation * m.hill.max_isometric_force) as f32;
@@ -558,42 +572,45 @@ impl Simulation {
                     contraction: c,
                     ..load
                 };
-                let e = m.chain.end_forces(&load, None);
+                let e = m.chain.end_forces(&load);
                 m.force = f64::from(e.insertion.length());
                 m.fibre = m
                     .hill
                     .rigid_tendon_kinematics(m.path_length, m.path_velocity);
-                (c, e)
+                (c, Some(e))
             };
             loads.push(ChainLoad {
                 contraction: tension,
                 ..load
             });
-            let n = m.chain.len();
-            let ins = m.chain.x[n - 1];
-            let org = m.chain.x[0];
             let mut tau = 0.0;
-            if m.chain.insertion.body == BodyId::Shank {
-                forces.push((ends.insertion, ins));
-                tau += f64::from((ins - knee_point).cross(ends.insertion).dot(knee_dir));
+            if let Some(ends) = ends {
+                // The paper's model: only the end points pull the bones.
+                let n = m.chain.len();
+                let ends_on_shank = [
+                    (m.chain.origin.body, ends.origin, m.chain.x[0]),
+                    (m.chain.insertion.body, ends.insertion, m.chain.x[n - 1]),
+                ];
+                for (body, f, at) in ends_on_shank {
+                    if body == BodyId::Shank {
+                        forces.push((f, at));
+                        tau += f64::from((at - knee_point).cross(f).dot(knee_dir));
+                    }
+                }
+            } else {
+                // The tendon force pulls the shank where the path first reaches it (the
+                // patella for the quadriceps), so the torque is exactly force × moment arm.
+                for p in m.chain.pulls_on(BodyId::Shank) {
+                    let f = p.dir * tension;
+                    forces.push((f, p.at));
+                    tau += f64::from((p.at - knee_point).cross(f).dot(knee_dir));
+                }
             }
-            if m.chain.origin.body == BodyId::Shank {
-                forces.push((ends.origin, org));
-                tau += f64::from((org - knee_point).cross(ends.origin).dot(knee_dir));
-            }
-            let f = f64::from(ends.insertion.length().max(ends.origin.length()));
             m.moment_arm = if m.crosses_knee {
-                let dir = m.chain.segment(n - 2).dir_b;
-                let sgn = if m.chain.insertion.body == BodyId::Shank {
-                    1.0
-                } else {
-                    -1.0
-                };
-                sgn * f64::from((ins - knee_point).cross(dir).dot(knee_dir))
+                m.chain.moment_arm(&axis, BodyId::Shank)
             } else {
                 0.0
             };
-            let _ = f;
             torque += tau;
         }
         self.knee_torque = torque;
