@@ -6,10 +6,10 @@ use std::sync::OnceLock;
 
 use glam::Quat;
 use myoslice::body::{Skeleton, SkeletonOptions, knee_axis};
-use myoslice::muscle::MuscleCatalogue;
 use myoslice::muscle::hill::{
     activation_rate, active_force_length, force_velocity, passive_force_length, tendon_force_length,
 };
+use myoslice::muscle::{MuscleCatalogue, MuscleGroup};
 use myoslice::prelude::*;
 
 const HAMSTRINGS: [&str; 4] = [
@@ -352,6 +352,27 @@ fn moment_arms_lie_in_published_human_ranges() {
         );
     }
     println!("{report}");
+}
+
+#[test]
+fn every_knee_flexor_flexes_and_every_extensor_extends_over_the_range() {
+    let base = sim(config());
+    for deg in [0.0, 30.0, 60.0, 90.0, 120.0] {
+        let mut s = base.clone();
+        s.set_knee(f64::to_radians(deg), 0.0).unwrap();
+        for m in s.muscles().iter().filter(|m| m.crosses_knee) {
+            let r = m.moment_arm;
+            match m.group {
+                MuscleGroup::Flexor => {
+                    assert!(r > 0.005, "{} at {deg}°: moment arm {r:.4} m", m.name)
+                }
+                MuscleGroup::Extensor => {
+                    assert!(r < -0.005, "{} at {deg}°: moment arm {r:.4} m", m.name)
+                }
+                MuscleGroup::Other => {}
+            }
+        }
+    }
 }
 
 #[test]

@@ -146,13 +146,22 @@ fn muscle_volumes_stay_within_one_percent(lattice: Lattice) {
         &MuscleCatalogue::default(),
     )
     .unwrap();
-    let (mut lo, mut hi) = (1.0f32, 1.0f32);
+    let names: Vec<String> = sim.muscles().iter().map(|m| m.name.clone()).collect();
+    let mut range = vec![(1.0f32, 1.0f32); names.len()];
     let max = flex_and_back(&mut sim, 1.0, |s| {
-        for r in &s.tissue_metrics().unwrap().muscle_volume_ratio {
-            lo = lo.min(*r);
-            hi = hi.max(*r);
+        let ratios = &s.tissue_metrics().unwrap().muscle_volume_ratio;
+        for (r, v) in range.iter_mut().zip(ratios) {
+            *r = (r.0.min(*v), r.1.max(*v));
         }
     });
+    let lo = range.iter().map(|r| r.0).fold(1.0, f32::min);
+    let hi = range.iter().map(|r| r.1).fold(1.0, f32::max);
+    let outside: Vec<String> = names
+        .iter()
+        .zip(&range)
+        .filter(|(_, r)| r.0 <= 0.99 || r.1 >= 1.01)
+        .map(|(n, r)| format!("{n} [{:.4}, {:.4}]", r.0, r.1))
+        .collect();
     assert!(
         max.to_degrees() > 125.0,
         "the flexion reached only {:.1}°",
@@ -160,7 +169,7 @@ fn muscle_volumes_stay_within_one_percent(lattice: Lattice) {
     );
     assert!(
         lo > 0.99 && hi < 1.01,
-        "muscle volume ratio range [{lo:.4}, {hi:.4}]"
+        "muscle volume ratio range [{lo:.4}, {hi:.4}]; outside ±1 %: {outside:?}"
     );
 }
 

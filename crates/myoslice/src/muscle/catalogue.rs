@@ -62,6 +62,10 @@ pub struct CatalogueEntry {
     /// the insertion bone to the muscle's end among those that low (hamstring and pes
     /// anserinus tendons insert below the joint line, not on the plateau's rim).
     pub insertion_below_knee_m: Option<f64>,
+    /// The origin lies at least this far (m) above the knee axis: the nearest point of the
+    /// origin bone to the muscle's end among those that high (the gastrocnemius heads
+    /// arise above the condyles' articular surfaces, not level with the flexion axis).
+    pub origin_above_knee_m: Option<f64>,
     /// Normalised fibre length at the rest pose (default from `[default]`).
     pub rest_fibre_length: Option<f64>,
     /// A via point on the origin's body this far (m) above the insertion at rest: the
@@ -164,6 +168,7 @@ impl MuscleCatalogue {
                 ("max_contraction_velocity", e.max_contraction_velocity),
                 ("wrap_radius_m", e.wrap_radius_m),
                 ("insertion_below_knee_m", e.insertion_below_knee_m),
+                ("origin_above_knee_m", e.origin_above_knee_m),
                 ("via_above_insertion_m", e.via_above_insertion_m),
                 ("rest_fibre_length", e.rest_fibre_length),
             ] {

@@ -15,6 +15,10 @@ use crate::lattice::{Lattice, MuscleLattice};
 /// Chain points of knee-crossing muscles keep this distance (m) from the knee axis.
 const KNEE_CLEARANCE: f32 = 0.10;
 
+/// Interior points of a knee-crossing belly that starts at the knee keep this distance
+/// (m) from the axis.
+const ORIGIN_CLEARANCE: f32 = 0.06;
+
 /// Muscle tissue density (kg/m³).
 pub const MUSCLE_DENSITY: f64 = 1060.0;
 
@@ -148,18 +152,23 @@ impl MuscleUnit {
             Some("inferior") => extreme(meshes[bone], Vec3::NEG_Z),
             _ => project(bone, end),
         };
-        let o_att = site(ob, o_end, entry.and_then(|e| e.origin_site.as_ref()));
-        let i_att = match entry.and_then(|e| e.insertion_below_knee_m) {
-            Some(d) => meshes[ib]
+        // The vertex of `bone` nearest `end` among those on the far side of a level `d`
+        // above (+) or below (−) the knee axis.
+        let beyond = |bone: usize, end: Vec3, d: f32| {
+            meshes[bone]
                 .vertices()
                 .iter()
                 .copied()
-                .filter(|v| v.z <= knee.point.z - d as f32)
-                .min_by(|a, b| {
-                    a.distance_squared(i_end)
-                        .total_cmp(&b.distance_squared(i_end))
-                })
-                .unwrap_or_else(|| project(ib, i_end)),
+                .filter(|v| (v.z - knee.point.z) * d.signum() >= d.abs())
+                .min_by(|a, b| a.distance_squared(end).total_cmp(&b.distance_squared(end)))
+                .unwrap_or_else(|| project(bone, end))
+        };
+        let o_att = match entry.and_then(|e| e.origin_above_knee_m) {
+            Some(d) => beyond(ob, o_end, d as f32),
+            None => site(ob, o_end, entry.and_then(|e| e.origin_site.as_ref())),
+        };
+        let i_att = match entry.and_then(|e| e.insertion_below_knee_m) {
+            Some(d) => beyond(ib, i_end, -d as f32),
             None => site(ib, i_end, entry.and_then(|e| e.insertion_site.as_ref())),
         };
         let belly_len: f64 = belly
@@ -184,6 +193,7 @@ impl MuscleUnit {
         // past at deep flexion; the tendon runs from the last point clear of the knee.
         let crossing =
             body_of_bone(&lattice.bones[ob].name) != body_of_bone(&lattice.bones[ib].name);
+        let mut belly_from_origin = drop_first;
         if crossing {
             let dist = |p: Vec3| {
                 let d = p - knee.point;
@@ -194,6 +204,13 @@ impl MuscleUnit {
                 && pts[pts.len() - 1].z > knee.point.z - KNEE_CLEARANCE
             {
                 pts.pop();
+            }
+            // Likewise where the belly starts at the knee (the gastrocnemii arise on the
+            // condyles): its first points would be pulleys on whichever bone lies
+            // nearest, turning the line of action through the axis as the knee bends.
+            while pts.len() > 1 && dist(pts[0]) < ORIGIN_CLEARANCE {
+                pts.remove(0);
+                belly_from_origin = true;
             }
         }
         let mut x = Vec::with_capacity(pts.len() + 3);
@@ -210,7 +227,8 @@ impl MuscleUnit {
         let n_via = usize::from(via.is_some());
         let tendon: Vec<bool> = (0..nseg)
             .map(|i| {
-                (i == 0 && !drop_first) || (i + 1 + n_via >= nseg && !(drop_last && n_via == 0))
+                (i == 0 && !belly_from_origin)
+                    || (i + 1 + n_via >= nseg && !(drop_last && n_via == 0))
             })
             .collect();
         let n = x.len();
@@ -289,7 +307,8 @@ impl MuscleUnit {
             scratch: Default::default(),
             geom: Vec::new(),
         };
-        if crosses_knee && wrap_fits(&chain, knee) {
+        let explicit_wrap = entry.and_then(|e| e.wrap_radius_m).is_some();
+        if crosses_knee && (explicit_wrap || wrap_fits(&chain, knee)) {
             // The segment crossing the knee: from the last point moving with the origin's
             // body to the next one.
             let k = (0..n - 1)
