@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Every test of myoslice, from a fresh machine: system packages (software Vulkan for the
-# off-screen viewer capture), Rust format/lint/tests, then the Python package built as a
-# wheel into a fresh virtual environment and its pytest suite (bindings, Gymnasium env,
-# stubs, scenario runs and their ParaView/Blender outputs).
+# off-screen viewer capture, Xvfb for the window's smoke test), Rust format/lint/tests,
+# then the Python package built as a wheel into a fresh virtual environment and its
+# pytest suite (bindings, Gymnasium env, stubs, scenario runs and their ParaView/Blender
+# outputs).
 # Usage: scripts/test.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,8 +16,11 @@ step() { printf '\n==> %s (%ss)\n' "$*" "$(( $(date +%s) - start ))"; }
 need_pkgs=()
 dpkg -s mesa-vulkan-drivers >/dev/null 2>&1 || need_pkgs+=(mesa-vulkan-drivers)
 dpkg -s libvulkan1 >/dev/null 2>&1 || need_pkgs+=(libvulkan1)
+# A virtual X display for the interactive window's smoke test.
+dpkg -s xvfb >/dev/null 2>&1 || need_pkgs+=(xvfb)
+dpkg -s xauth >/dev/null 2>&1 || need_pkgs+=(xauth)
 if [ ${#need_pkgs[@]} -gt 0 ]; then
-  step "installing ${need_pkgs[*]} (software Vulkan for off-screen rendering)"
+  step "installing ${need_pkgs[*]} (software Vulkan, virtual display)"
   sudo_cmd=""
   [ "$(id -u)" = 0 ] || sudo_cmd="sudo"
   $sudo_cmd apt-get update -qq
@@ -28,7 +32,7 @@ step "cargo fmt --check"
 cargo fmt --all -- --check
 step "cargo clippy (warnings are errors)"
 cargo clippy --workspace --all-targets -- -D warnings
-step "cargo test (core, CLI, viewer incl. off-screen capture on the software adapter)"
+step "cargo test (core, CLI, viewer incl. off-screen capture and the window on Xvfb, software adapter)"
 # The Python crate is tested through its wheel below (its test binary would embed Python).
 cargo test --workspace --exclude myoslice-py
 step "release CLI (reference for the Python parity tests, scenario runs)"

@@ -22,8 +22,55 @@ use crate::ui::{UiAction, UiState};
 /// How far (px) the pointer may move between press and release and still be a click.
 const CLICK_SLOP_PX: f64 = 4.0;
 
-/// Opens the window on a model (or a scenario) and runs until it is closed.
-pub fn run(source: ModelSource, scenario: Option<PathBuf>) -> Result<()> {
+/// How an interactive session ends.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RunOptions {
+    /// Close by itself after this many frames and print their timing (smoke tests,
+    /// frame-time measurements); `None` runs until the window is closed.
+    pub exit_after_frames: Option<u64>,
+}
+
+/// Frame-time figures of a session.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct FrameStats {
+    /// Frames presented.
+    pub frames: u64,
+    /// The first frame (ms): start-up, pipeline compilation.
+    pub first_ms: f64,
+    /// Wall time of the frames after the first (s).
+    pub wall_s: f64,
+    /// Of which simulating (s).
+    pub sim_s: f64,
+    /// Slowest frame after the first (ms).
+    pub worst_ms: f64,
+}
+
+impl FrameStats {
+    fn add(&mut self, frame_s: f64, sim_s: f64) {
+        if self.frames == 0 {
+            self.first_ms = frame_s * 1e3;
+        } else {
+            self.worst_ms = self.worst_ms.max(frame_s * 1e3);
+            self.wall_s += frame_s;
+            self.sim_s += sim_s;
+        }
+        self.frames += 1;
+    }
+
+    /// Mean frame time after the first (ms).
+    pub fn mean_ms(&self) -> f64 {
+        1e3 * self.wall_s / self.frames.saturating_sub(1).max(1) as f64
+    }
+
+    /// Mean simulation time per frame after the first (ms).
+    pub fn mean_sim_ms(&self) -> f64 {
+        1e3 * self.sim_s / self.frames.saturating_sub(1).max(1) as f64
+    }
+}
+
+/// Opens the window on a model (or a scenario) and runs until it is closed (or for
+/// `opts.exit_after_frames`); returns the frame timing.
+pub fn run(source: ModelSource, scenario: Option<PathBuf>, opts: RunOptions) -> Result<FrameStats> {
     let event_loop = EventLoop::new().map_err(|e| {
         anyhow!("cannot open a window ({e}); without a display, use `viewer --capture out.png`")
     })?;
@@ -56,13 +103,15 @@ pub fn run(source: ModelSource, scenario: Option<PathBuf>) -> Result<()> {
         press: None,
         last: Instant::now(),
         fatal: None,
+        opts,
+        stats: FrameStats::default(),
     };
     event_loop
         .run_app(&mut app)
         .map_err(|e| anyhow!("event loop: {e}"))?;
     match app.fatal {
         Some(e) => Err(e),
-        None => Ok(()),
+        None => Ok(app.stats),
     }
 }
 
@@ -101,6 +150,8 @@ struct App {
     press: Option<((f64, f64), Option<usize>)>,
     last: Instant,
     fatal: Option<anyhow::Error>,
+    opts: RunOptions,
+    stats: FrameStats,
 }
 
 fn targets(
@@ -194,9 +245,11 @@ impl App {
 
     fn advance(&mut self) {
         let now = Instant::now();
-        let real = now.duration_since(self.last).as_secs_f64().min(0.1);
+        let elapsed = now.duration_since(self.last).as_secs_f64();
         self.last = now;
-        self.ui.frame_ms = (real * 1e3) as f32;
+        self.ui.frame_ms = (elapsed * 1e3) as f32;
+        // A stall (window dragged, slow frame) does not make the simulation jump.
+        let real = elapsed.min(0.1);
         if self.ui.playing {
             let t0 = Instant::now();
             let dt = (real * self.ui.speed).clamp(1e-4, 0.05);
@@ -379,6 +432,10 @@ impl App {
         }
         g.window.pre_present_notify();
         g.gpu.queue.present(frame);
+        self.stats.add(
+            f64::from(self.ui.frame_ms) * 1e-3,
+            f64::from(self.ui.sim_ms) * 1e-3,
+        );
         self.act(actions);
     }
 }
@@ -457,7 +514,15 @@ impl ApplicationHandler for App {
         }
     }
 
-    fn about_to_wait(&mut self, _el: &ActiveEventLoop) {
+    fn about_to_wait(&mut self, el: &ActiveEventLoop) {
+        if self
+            .opts
+            .exit_after_frames
+            .is_some_and(|n| self.stats.frames >= n)
+        {
+            el.exit();
+            return;
+        }
         if let Some(g) = &self.gfx {
             g.window.request_redraw();
         }

@@ -68,6 +68,10 @@ struct Args {
     /// No colour-bar legend in captures.
     #[arg(long)]
     no_legend: bool,
+    /// Interactive window: close by itself after this many frames and print the frame
+    /// timing (for smoke tests and frame-time measurements).
+    #[arg(long, conflicts_with = "capture")]
+    exit_after_frames: Option<u64>,
     /// Also write what the PNG shows (time, knee angle, the knee's pixel) as JSON here.
     #[arg(long, requires = "capture")]
     meta: Option<PathBuf>,
@@ -210,7 +214,21 @@ fn main() -> ExitCode {
             },
             _ => ModelSource::Phantom,
         };
-        app::run(source, args.scenario.clone())
+        let opts = app::RunOptions {
+            exit_after_frames: args.exit_after_frames,
+        };
+        app::run(source, args.scenario.clone(), opts).map(|stats| {
+            if args.exit_after_frames.is_some() {
+                println!(
+                    "window: {} frames; first {:.0} ms; then mean {:.1} ms (simulating {:.1} ms), slowest {:.1} ms",
+                    stats.frames,
+                    stats.first_ms,
+                    stats.mean_ms(),
+                    stats.mean_sim_ms(),
+                    stats.worst_ms
+                );
+            }
+        })
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
