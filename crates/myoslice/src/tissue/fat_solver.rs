@@ -3,15 +3,62 @@
 //! of the polar decomposition of `Σ (x_i − c) R_iᵀ` and placed at its current centroid;
 //! every free vertex moves toward the mean of its elements' goals by a stiffness `k`.
 //! Data are struct-of-arrays in lattice order (slice-major), the rotation is warm-started
-//! and extracted branch-free, and element blocks run in parallel.
+//! and extracted branch-free, and element chunks run in parallel.
+//!
+//! Goals are scattered, not stored: each chunk of consecutive elements adds its corner
+//! goals into a buffer over the compact vertex range it touches, and the buffers are
+//! summed in chunk order. Chunks are fixed, so results do not depend on the thread count.
 
-use glam::{Mat3, Quat, Vec3};
+use glam::{Quat, Vec3, Vec3A};
 use rayon::prelude::*;
 
-use super::polar::rotation_step;
+use super::fat_lanes::{LANES, RestLanes, group_pass, rest_lanes};
 
-/// Elements per parallel block.
+/// Vertices per parallel block of the vertex pass.
 const BLOCK: usize = 2048;
+
+/// Elements per chunk of the element pass (a multiple of [`LANES`]).
+const CHUNK: usize = 512;
+
+/// Consecutive elements, the vertices they touch, and the goal sums over those.
+#[derive(Debug, Clone)]
+struct Chunk {
+    /// Elements `first..first + len`.
+    first: usize,
+    len: usize,
+    /// The vertices touched, ascending.
+    verts: Vec<u32>,
+    /// Each element's corners as indices into `verts`.
+    local: Vec<[u16; 8]>,
+    /// Σ goals per vertex of `verts` (scratch).
+    sum: Vec<Vec3A>,
+    /// Whether any element of the chunk was active in the last pass.
+    used: bool,
+}
+
+impl Chunk {
+    fn new(hexes: &[[u32; 8]], first: usize, len: usize) -> Self {
+        let mut verts: Vec<u32> = hexes[first..first + len]
+            .iter()
+            .flatten()
+            .copied()
+            .collect();
+        verts.sort_unstable();
+        verts.dedup();
+        let local = hexes[first..first + len]
+            .iter()
+            .map(|h| h.map(|v| verts.partition_point(|&u| u < v) as u16))
+            .collect();
+        Self {
+            first,
+            len,
+            sum: vec![Vec3A::ZERO; verts.len()],
+            verts,
+            local,
+            used: false,
+        }
+    }
+}
 
 /// The shape-matching state of a hexahedral lattice.
 #[derive(Debug, Clone)]
@@ -24,10 +71,17 @@ pub struct FatSolver {
     pub hexes: Vec<[u32; 8]>,
     /// Rest positions relative to each element's rest centroid.
     rel: Vec<[Vec3; 8]>,
+    /// The same, four elements per group as SIMD lanes (the kernel's layout).
+    rest4: Vec<RestLanes>,
     /// Current rotation of each element (warm start).
     pub rot: Vec<Quat>,
-    /// Goal position of each element corner (scratch).
-    goals: Vec<[Vec3; 8]>,
+    /// Element chunks of the scatter.
+    chunks: Vec<Chunk>,
+    /// 1 / number of elements at each vertex (0 for none).
+    inv_count: Vec<f32>,
+    /// Vertex block → the chunks whose vertex range meets it (CSR, chunk order).
+    block_start: Vec<u32>,
+    block_chunks: Vec<u32>,
     /// Vertex → element corners (`hex * 8 + corner`), CSR.
     inc_start: Vec<u32>,
     inc: Vec<u32>,
@@ -43,7 +97,7 @@ pub struct FatSolver {
 impl FatSolver {
     /// A solver at rest for a lattice.
     pub fn new(rest: &[Vec3], hexes: &[[u32; 8]]) -> Self {
-        let rel = hexes
+        let rel: Vec<[Vec3; 8]> = hexes
             .iter()
             .map(|h| {
                 let p = h.map(|i| rest[i as usize]);
@@ -72,14 +126,31 @@ impl FatSolver {
             .iter()
             .map(|h| crate::lattice::hex_volume_points(&h.map(|i| rest[i as usize].as_dvec3())))
             .collect();
+        // At most 8 × CHUNK corners: local indices fit u16.
+        let chunks: Vec<Chunk> = (0..hexes.len())
+            .step_by(CHUNK)
+            .map(|first| Chunk::new(hexes, first, CHUNK.min(hexes.len() - first)))
+            .collect();
+        let (block_start, block_chunks) = block_lists(&chunks, rest.len());
+        let rest4 = rel.chunks(LANES).map(rest_lanes).collect();
+        let inv_count = (0..rest.len())
+            .map(|v| match count[v + 1] - count[v] {
+                0 => 0.0,
+                n => 1.0 / n as f32,
+            })
+            .collect();
         Self {
             rest_volume,
             rest: rest.to_vec(),
             x: rest.to_vec(),
             hexes: hexes.to_vec(),
             rel,
+            rest4,
             rot: vec![Quat::IDENTITY; hexes.len()],
-            goals: vec![[Vec3::ZERO; 8]; hexes.len()],
+            chunks,
+            inv_count,
+            block_start,
+            block_chunks,
             inc_start: count,
             inc,
             free: vec![true; rest.len()],
@@ -128,71 +199,74 @@ impl FatSolver {
     /// One shape-matching iteration: element goals, then every free vertex moves a
     /// fraction `k` toward the mean of its goals.
     pub fn iterate(&mut self, k: f32) {
-        self.compute_goals();
-        let goals = &self.goals;
-        let (inc_start, inc) = (&self.inc_start, &self.inc);
-        let free = &self.free;
+        self.scatter_goals();
+        let (free, inv) = (&self.free, &self.inv_count);
+        let (chunks, start, list) = (&self.chunks, &self.block_start, &self.block_chunks);
         self.x
             .par_chunks_mut(BLOCK)
             .enumerate()
-            .for_each(|(b, chunk)| {
-                for (o, x) in chunk.iter_mut().enumerate() {
-                    let v = b * BLOCK + o;
-                    if !free[v] {
+            .for_each(|(b, xs)| {
+                let base = b * BLOCK;
+                // Σ goals of this block's vertices, chunk by chunk in order (deterministic).
+                let mut acc = [Vec3A::ZERO; BLOCK];
+                for &ci in &list[start[b] as usize..start[b + 1] as usize] {
+                    let c = &chunks[ci as usize];
+                    if !c.used {
                         continue;
                     }
-                    let (s, e) = (inc_start[v] as usize, inc_start[v + 1] as usize);
-                    if s == e {
-                        continue;
+                    let from = c.verts.partition_point(|&v| (v as usize) < base);
+                    let to = c.verts.partition_point(|&v| (v as usize) < base + xs.len());
+                    for (v, g) in c.verts[from..to].iter().zip(&c.sum[from..to]) {
+                        acc[*v as usize - base] += *g;
                     }
-                    let mut g = Vec3::ZERO;
-                    for &c in &inc[s..e] {
-                        g += goals[(c >> 3) as usize][(c & 7) as usize];
+                }
+                for (o, (x, g)) in xs.iter_mut().zip(&acc).enumerate() {
+                    let v = base + o;
+                    if free[v] && inv[v] > 0.0 {
+                        let g = Vec3::from(*g * inv[v]);
+                        *x += (g - *x) * k;
                     }
-                    let g = g / (e - s) as f32;
-                    *x += (g - *x) * k;
                 }
             });
     }
 
-    /// Goals of every element from the current positions (rotation warm-started, one
-    /// trigonometry-free iteration per pass).
-    pub fn compute_goals(&mut self) {
-        let x = &self.x;
-        let hexes = &self.hexes;
-        let rel = &self.rel;
-        let active = &self.active;
-        self.goals
-            .par_chunks_mut(BLOCK)
-            .zip(self.rot.par_chunks_mut(BLOCK))
-            .enumerate()
-            .for_each(|(b, (goals, rots))| {
-                let base = b * BLOCK;
-                for (o, (g, q)) in goals.iter_mut().zip(rots.iter_mut()).enumerate() {
-                    let e = base + o;
-                    if !active[e] {
-                        continue;
-                    }
-                    let h = &hexes[e];
-                    let r = &rel[e];
-                    let mut p = [Vec3::ZERO; 8];
-                    let mut c = Vec3::ZERO;
-                    for k in 0..8 {
-                        p[k] = x[h[k] as usize];
-                        c += p[k];
-                    }
-                    c *= 0.125;
-                    let (mut a0, mut a1, mut a2) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
-                    for k in 0..8 {
-                        let d = p[k] - c;
-                        a0 += d * r[k].x;
-                        a1 += d * r[k].y;
-                        a2 += d * r[k].z;
-                    }
-                    let (q2, m) = rotation_step(&Mat3::from_cols(a0, a1, a2), *q);
-                    *q = q2;
-                    for k in 0..8 {
-                        g[k] = c + m * r[k];
+    /// Every active element's goals (rest shape turned by its warm-started rotation, one
+    /// trigonometry-free step per pass, placed at its centroid), summed per vertex into
+    /// its chunk's buffer.
+    fn scatter_goals(&mut self) {
+        let (x, hexes, rest4, active) = (&self.x, &self.hexes, &self.rest4, &self.active);
+        let rot = &mut self.rot;
+        // Each chunk owns its elements' rotations: split them alongside.
+        let mut rots: Vec<&mut [Quat]> = Vec::with_capacity(self.chunks.len());
+        let mut rest = rot.as_mut_slice();
+        for c in &self.chunks {
+            let (head, tail) = rest.split_at_mut(c.len);
+            rots.push(head);
+            rest = tail;
+        }
+        self.chunks
+            .par_iter_mut()
+            .zip(rots.into_par_iter())
+            .for_each(|(c, rots)| {
+                c.used = active[c.first..c.first + c.len].iter().any(|a| *a);
+                if !c.used {
+                    return;
+                }
+                c.sum.iter_mut().for_each(|s| *s = Vec3A::ZERO);
+                for o in (0..c.len).step_by(LANES) {
+                    let e = c.first + o;
+                    let n = LANES.min(c.len - o);
+                    let act = &active[e..e + n];
+                    if act.iter().any(|a| *a) {
+                        group_pass(
+                            x,
+                            &hexes[e..e + n],
+                            &rest4[e / LANES],
+                            &mut rots[o..o + n],
+                            act,
+                            &c.local[o..o + n],
+                            &mut c.sum,
+                        );
                     }
                 }
             });
@@ -243,9 +317,93 @@ impl FatSolver {
     }
 }
 
+/// For each block of [`BLOCK`] vertices, the chunks whose vertex range meets it.
+fn block_lists(chunks: &[Chunk], n_vertices: usize) -> (Vec<u32>, Vec<u32>) {
+    let n_blocks = n_vertices.div_ceil(BLOCK);
+    let mut lists: Vec<Vec<u32>> = vec![Vec::new(); n_blocks];
+    for (ci, c) in chunks.iter().enumerate() {
+        let mut last = usize::MAX;
+        for &v in &c.verts {
+            let b = v as usize / BLOCK;
+            if b != last && b < n_blocks {
+                lists[b].push(ci as u32);
+                last = b;
+            }
+        }
+    }
+    let mut start = vec![0u32];
+    let mut all = Vec::new();
+    for l in lists {
+        all.extend(l);
+        start.push(all.len() as u32);
+    }
+    (start, all)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::tissue::polar::rotation_step;
+    use glam::Mat3;
+
+    #[test]
+    fn the_four_lane_kernel_matches_the_scalar_shape_matching_step() {
+        // 27 elements: six full groups of four and a partial one; some inactive.
+        let mut s = FatSolver::grid(3, 3, 3, 0.01);
+        for (i, p) in s.x.iter_mut().enumerate() {
+            *p += Vec3::new((i % 5) as f32, (i % 3) as f32, (i % 7) as f32) * 0.0007;
+        }
+        for (e, q) in s.rot.iter_mut().enumerate() {
+            *q = Quat::from_axis_angle(Vec3::new(1.0, 0.5, 0.2).normalize(), 0.02 * e as f32);
+        }
+        // As `restrict_to` leaves it: a vertex of an idle element is not free.
+        for e in [5, 25] {
+            s.active[e] = false;
+            for v in s.hexes[e] {
+                s.free[v as usize] = false;
+            }
+        }
+        let (x0, rot0) = (s.x.clone(), s.rot.clone());
+        // The scalar reference: goals per element, the mean at each vertex.
+        let mut sum = vec![Vec3::ZERO; x0.len()];
+        let mut rot = rot0.clone();
+        for (e, h) in s.hexes.iter().enumerate() {
+            if !s.active[e] {
+                continue;
+            }
+            let p = h.map(|v| x0[v as usize]);
+            let c = p.iter().copied().sum::<Vec3>() / 8.0;
+            let r = s.rel[e];
+            let a = Mat3::from_cols(
+                (0..8).map(|i| (p[i] - c) * r[i].x).sum(),
+                (0..8).map(|i| (p[i] - c) * r[i].y).sum(),
+                (0..8).map(|i| (p[i] - c) * r[i].z).sum(),
+            );
+            let (q, m) = rotation_step(&a, rot0[e]);
+            rot[e] = q;
+            for i in 0..8 {
+                sum[h[i] as usize] += c + m * r[i];
+            }
+        }
+        s.iterate(0.5);
+        assert!(s.free.iter().filter(|f| **f).count() > 20);
+        for (e, (a, b)) in s.rot.iter().zip(&rot).enumerate() {
+            assert!(a.dot(*b).abs() > 1.0 - 1e-6, "element {e}: {a} vs {b}");
+        }
+        for v in 0..x0.len() {
+            let n = s.elements_of(v).count() as f32;
+            let want = if s.free[v] {
+                x0[v] + (sum[v] / n - x0[v]) * 0.5
+            } else {
+                x0[v]
+            };
+            assert!(
+                s.x[v].distance(want) < 1e-6,
+                "vertex {v}: {} vs {want}",
+                s.x[v]
+            );
+        }
+    }
 
     #[test]
     fn a_perturbed_block_returns_to_its_rest_shape_up_to_a_rigid_motion() {

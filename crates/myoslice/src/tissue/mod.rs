@@ -2,6 +2,7 @@
 //! that follows muscles and bones, the knee fold and contact plane behind the knee, a
 //! validity guard, and the per-element metrics of the paper (section 5.3).
 
+mod fat_lanes;
 pub mod fat_solver;
 pub mod intersect;
 pub mod knee_fold;
