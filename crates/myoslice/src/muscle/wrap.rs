@@ -102,18 +102,19 @@ impl WrapCylinder {
             return straight(p, q);
         }
         let sg = f64::from(self.side);
-        let (pa, pb) = (a.y.atan2(a.x), b.y.atan2(b.x));
-        let (ba, bb) = ((r / da).acos(), (r / db).acos());
-        let th1 = pa + sg * ba;
-        let th2 = pb - sg * bb;
-        let tau = std::f64::consts::TAU;
-        let arc = (sg * (th2 - th1)).rem_euclid(tau);
+        // Tangent points: each end's direction turned by ±acos(r/d) (toward the side the
+        // path goes round), without trigonometry; one atan2 for the arc between them.
+        let tangent = |u: DVec2, d: f64, turn: f64| {
+            let (c, sn) = (r / d, turn * (1.0 - (r / d).powi(2)).max(0.0).sqrt());
+            DVec2::new(u.x * c - u.y * sn, u.x * sn + u.y * c) * r
+        };
+        let t1 = tangent(a / da, da, sg);
+        let t2 = tangent(b / db, db, -sg);
+        let arc = (sg * t1.perp_dot(t2)).atan2(t1.dot(t2)).rem_euclid(std::f64::consts::TAU);
         if arc > 1.75 * std::f64::consts::PI {
             // Nearly a full turn: the points sit where no tendon could; go straight.
             return straight(p, q);
         }
-        let t1 = DVec2::new(th1.cos(), th1.sin()) * r;
-        let t2 = DVec2::new(th2.cos(), th2.sin()) * r;
         let (l1, l2, l3) = ((t1 - a).length(), arc * r, (b - t2).length());
         let total = (l1 + l2 + l3).max(1e-12);
         // Along the axis the path climbs linearly with its length.

@@ -80,6 +80,8 @@ pub struct Simulation {
     frames: BodyFrames,
     knee_torque: f64,
     tissue: Option<Tissue>,
+    /// Per-substep buffers, kept to avoid allocating every step.
+    scratch: (Vec<(Vec3, Vec3)>, Vec<ChainLoad>),
 }
 
 impl Simulation {
@@ -146,6 +148,7 @@ impl Simulation {
             frames: BodyFrames::REST,
             knee_torque: 0.0,
             tissue: None,
+            scratch: Default::default(),
         };
         if let Some(bones) = bones {
             // The tissue's rest is the chains' equilibrium at rest (see `settle`); the
@@ -527,7 +530,9 @@ impl Simulation {
         let gravity = self.skeleton.gravity();
         let knee = *self.skeleton.knee();
         let hill = self.config.muscle_model == MuscleModel::Hill;
-        let mut forces = Vec::with_capacity(2 * self.muscles.len());
+        let (mut forces, mut loads) = std::mem::take(&mut self.scratch);
+        forces.clear();
+        loads.clear();
         let mut torque = 0.0;
         let frames = self.frames;
         let knee_point = frames.point(BodyId::Thigh, knee.point);
@@ -536,7 +541,6 @@ impl Simulation {
             point: knee_point,
             dir: knee_dir,
         };
-        let mut loads = Vec::with_capacity(self.muscles.len());
         for (m, sched) in self.muscles.iter_mut().zip(&self.schedules) {
             if let Some(s) = sched {
                 m.excitation = s.value(self.time);
@@ -653,6 +657,7 @@ impl Simulation {
         self.frames = next;
         self.time += h;
         self.steps += 1;
+        self.scratch = (forces, loads);
     }
 
     /// A checkpoint of everything that changes while stepping.
