@@ -180,7 +180,11 @@ impl UiState {
         if m.crosses_knee {
             text += &format!(", moment arm {:+.1} cm", m.moment_arm * 100.0);
         }
-        text += "\nclick to select";
+        text += if self.selected == self.hovered {
+            "\nclick to clear"
+        } else {
+            "\nclick to select"
+        };
         Some(text)
     }
 

@@ -110,7 +110,9 @@ impl WrapCylinder {
         };
         let t1 = tangent(a / da, da, sg);
         let t2 = tangent(b / db, db, -sg);
-        let arc = (sg * t1.perp_dot(t2)).atan2(t1.dot(t2)).rem_euclid(std::f64::consts::TAU);
+        let arc = (sg * t1.perp_dot(t2))
+            .atan2(t1.dot(t2))
+            .rem_euclid(std::f64::consts::TAU);
         if arc > 1.75 * std::f64::consts::PI {
             // Nearly a full turn: the points sit where no tendon could; go straight.
             return straight(p, q);
