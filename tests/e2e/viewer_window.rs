@@ -4,8 +4,9 @@
 #![allow(clippy::unwrap_used)]
 
 use std::process::Command;
+use std::time::{Duration, Instant};
 
-use myoslice_e2e::binary;
+use myoslice_e2e::{binary, scratch};
 
 /// `xvfb-run`, or `None` (loudly) when it is absent and `MYOSLICE_ALLOW_NO_XVFB=1` says
 /// that is expected. Without that variable a missing Xvfb fails the test: the window must
@@ -31,20 +32,35 @@ fn xvfb_run() -> Option<std::path::PathBuf> {
 fn the_window_opens_on_the_phantom_presents_frames_and_closes() {
     let viewer = binary("myoslice-viewer", "viewer");
     let Some(xvfb) = xvfb_run() else { return };
-    let o = Command::new(xvfb)
+    let dir = scratch("window");
+    let (out, err) = (dir.join("stdout.txt"), dir.join("stderr.txt"));
+    let mut child = Command::new(xvfb)
         .args(["-a", "-s", "-screen 0 1600x1000x24"])
         .arg(&viewer)
         .args(["--exit-after-frames", "20"])
         // Only the virtual display: never a Wayland compositor of the machine running it.
         .env_remove("WAYLAND_DISPLAY")
-        .output()
+        .stdout(std::fs::File::create(&out).unwrap())
+        .stderr(std::fs::File::create(&err).unwrap())
+        .spawn()
         .unwrap();
-    let stdout = String::from_utf8_lossy(&o.stdout);
-    let stderr = String::from_utf8_lossy(&o.stderr);
+    // A window that never presents must fail the test, not hang it.
+    let deadline = Instant::now() + Duration::from_secs(300);
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            panic!("the window did not present 20 frames within 300 s");
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    let stdout = std::fs::read_to_string(&out).unwrap();
+    let stderr = std::fs::read_to_string(&err).unwrap();
     assert!(
-        o.status.success(),
-        "the window failed: {}\n{stdout}\n{stderr}",
-        o.status
+        status.success(),
+        "the window failed: {status}\n{stdout}\n{stderr}"
     );
     println!("{stdout}");
     assert!(

@@ -259,6 +259,8 @@ impl App {
             }
             self.ui.sim_ms = (t0.elapsed().as_secs_f64() * 1e3) as f32;
             self.ui.record(&self.sim);
+        } else {
+            self.ui.sim_ms = 0.0;
         }
     }
 
@@ -465,6 +467,15 @@ impl ApplicationHandler for App {
                 g.depth = depth;
             }
             WindowEvent::RedrawRequested => self.redraw(),
+            // A release the panel takes still ends a press begun in the view.
+            WindowEvent::MouseInput {
+                state: ElementState::Released,
+                button: MouseButton::Left,
+                ..
+            } if resp.consumed => {
+                self.press = None;
+                self.drag = None;
+            }
             WindowEvent::MouseInput { state, button, .. } if !resp.consumed => {
                 // A left click that barely moved picks a muscle; a drag moves the camera.
                 match (state, button) {

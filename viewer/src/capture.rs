@@ -196,17 +196,24 @@ impl CaptureMeta {
         }
     }
 
-    /// As a JSON object.
+    /// As a JSON object (non-finite numbers as `null`).
     pub fn to_json(&self) -> String {
+        let num = |v: f64| {
+            if v.is_finite() {
+                format!("{v:?}")
+            } else {
+                "null".into()
+            }
+        };
         format!(
-            "{{\"width\": {}, \"height\": {}, \"time_s\": {:?}, \"knee_angle_deg\": {:?}, \"knee_px\": [{:?}, {:?}], \"px_per_m\": {:?}}}\n",
+            "{{\"width\": {}, \"height\": {}, \"time_s\": {}, \"knee_angle_deg\": {}, \"knee_px\": [{}, {}], \"px_per_m\": {}}}\n",
             self.size[0],
             self.size[1],
-            self.time,
-            self.knee_angle_deg,
-            self.knee_px[0],
-            self.knee_px[1],
-            self.px_per_m
+            num(self.time),
+            num(self.knee_angle_deg),
+            num(f64::from(self.knee_px[0])),
+            num(f64::from(self.knee_px[1])),
+            num(f64::from(self.px_per_m))
         )
     }
 

@@ -43,6 +43,9 @@ pub struct MuscleReadout {
     /// Fibre length over optimal fibre length.
     pub normalised_fibre_length: f64,
     /// Moment arm about the knee (m), positive for flexion; 0 when it does not cross it.
+    /// Geometric (virtual work, −dL/dθ): in Hill mode the knee torque is exactly tendon
+    /// force × moment arm; in the paper's spring mode the bones feel the end segments'
+    /// Eq. 1 forces instead, so the torque need not equal it.
     pub moment_arm: f64,
     /// Path length origin to insertion (m).
     pub path_length: f64,
@@ -601,9 +604,10 @@ impl Simulation {
                         tau += f64::from((at - knee_point).cross(f).dot(knee_dir));
                     }
                 }
-            } else {
+            } else if m.crosses_knee {
                 // The tendon force pulls the shank where the path first reaches it (the
                 // patella for the quadriceps), so the torque is exactly force × moment arm.
+                // (A muscle that does not cross the knee pulls only within its bone.)
                 for p in m.chain.pulls_on(BodyId::Shank) {
                     let f = p.dir * tension;
                     forces.push((f, p.at));

@@ -198,7 +198,16 @@ impl FatSolver {
 
     /// One shape-matching iteration: element goals, then every free vertex moves a
     /// fraction `k` toward the mean of its goals.
+    ///
+    /// Each free vertex's goals come from all its elements, which must then be active
+    /// (as [`Self::restrict_to`] and [`Self::release`] leave them).
     pub fn iterate(&mut self, k: f32) {
+        debug_assert!(
+            (0..self.x.len())
+                .filter(|&v| self.free[v])
+                .all(|v| self.elements_of(v).all(|e| self.active[e])),
+            "a free vertex has an inactive element"
+        );
         self.scatter_goals();
         let (free, inv) = (&self.free, &self.inv_count);
         let (chunks, start, list) = (&self.chunks, &self.block_start, &self.block_chunks);
