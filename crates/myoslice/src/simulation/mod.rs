@@ -194,16 +194,24 @@ impl Simulation {
         self.frames = self.current_frames();
         for m in &mut self.muscles {
             m.chain.v.iter_mut().for_each(|v| *v = Vec3::ZERO);
+        }
+        self.reattach_muscles();
+        (self.time, self.steps, self.knee_torque) = (0.0, 0, 0.0);
+    }
+
+    /// After the bones moved by a jump: every chain back on its attachments, its wrap,
+    /// path length and moment arm brought up to date, no excursion velocity.
+    fn reattach_muscles(&mut self) {
+        let axis = self.knee_axis();
+        for m in &mut self.muscles {
             m.chain.attach_ends(&self.frames);
             m.chain.update_wrap();
             m.path_length = m.chain.path_length();
             m.path_velocity = 0.0;
+            if m.crosses_knee {
+                m.moment_arm = m.chain.moment_arm(&axis, BodyId::Shank);
+            }
         }
-        let axis = self.knee_axis();
-        for m in self.muscles.iter_mut().filter(|m| m.crosses_knee) {
-            m.moment_arm = m.chain.moment_arm(&axis, BodyId::Shank);
-        }
-        (self.time, self.steps, self.knee_torque) = (0.0, 0, 0.0);
     }
 
     /// The built-in phantom with the default lattice options and muscle catalogue.
@@ -446,15 +454,8 @@ impl Simulation {
                 }
                 m.chain.v[i] = Vec3::ZERO;
             }
-            m.chain.attach_ends(&self.frames);
-            m.chain.update_wrap();
-            m.path_length = m.chain.path_length();
-            m.path_velocity = 0.0;
         }
-        let axis = self.knee_axis();
-        for m in self.muscles.iter_mut().filter(|m| m.crosses_knee) {
-            m.moment_arm = m.chain.moment_arm(&axis, BodyId::Shank);
-        }
+        self.reattach_muscles();
         if self.tissue.is_some() {
             // The fat follows a jump in a few relaxation passes.
             for _ in 0..4 {
