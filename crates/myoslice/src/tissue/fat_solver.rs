@@ -69,9 +69,8 @@ pub struct FatSolver {
     pub x: Vec<Vec3>,
     /// Hexahedra (vertex indices).
     pub hexes: Vec<[u32; 8]>,
-    /// Rest positions relative to each element's rest centroid.
-    rel: Vec<[Vec3; 8]>,
-    /// The same, four elements per group as SIMD lanes (the kernel's layout).
+    /// Rest corners relative to each element's rest centroid, four elements per group
+    /// as SIMD lanes (the kernel's layout).
     rest4: Vec<RestLanes>,
     /// Current rotation of each element (warm start).
     pub rot: Vec<Quat>,
@@ -97,14 +96,7 @@ pub struct FatSolver {
 impl FatSolver {
     /// A solver at rest for a lattice.
     pub fn new(rest: &[Vec3], hexes: &[[u32; 8]]) -> Self {
-        let rel: Vec<[Vec3; 8]> = hexes
-            .iter()
-            .map(|h| {
-                let p = h.map(|i| rest[i as usize]);
-                let c = p.iter().copied().sum::<Vec3>() / 8.0;
-                p.map(|q| q - c)
-            })
-            .collect();
+        let rel: Vec<[Vec3; 8]> = hexes.iter().map(|h| relative_corners(rest, h)).collect();
         let mut count = vec![0u32; rest.len() + 1];
         for h in hexes {
             for &v in h {
@@ -144,7 +136,6 @@ impl FatSolver {
             rest: rest.to_vec(),
             x: rest.to_vec(),
             hexes: hexes.to_vec(),
-            rel,
             rest4,
             rot: vec![Quat::IDENTITY; hexes.len()],
             chunks,
@@ -311,8 +302,8 @@ impl FatSolver {
     }
 
     /// Rest-relative corner vectors of element `e`.
-    pub fn rest_relative(&self, e: usize) -> &[Vec3; 8] {
-        &self.rel[e]
+    pub fn rest_relative(&self, e: usize) -> [Vec3; 8] {
+        relative_corners(&self.rest, &self.hexes[e])
     }
 
     /// Number of elements.
@@ -324,6 +315,13 @@ impl FatSolver {
     pub fn is_empty(&self) -> bool {
         self.hexes.is_empty()
     }
+}
+
+/// The corners of hexahedron `h` relative to its centroid.
+fn relative_corners(pos: &[Vec3], h: &[u32; 8]) -> [Vec3; 8] {
+    let p = h.map(|i| pos[i as usize]);
+    let c = p.iter().copied().sum::<Vec3>() / 8.0;
+    p.map(|q| q - c)
 }
 
 /// For each block of [`BLOCK`] vertices, the chunks whose vertex range meets it.
@@ -382,7 +380,7 @@ mod tests {
             }
             let p = h.map(|v| x0[v as usize]);
             let c = p.iter().copied().sum::<Vec3>() / 8.0;
-            let r = s.rel[e];
+            let r = s.rest_relative(e);
             let a = Mat3::from_cols(
                 (0..8).map(|i| (p[i] - c) * r[i].x).sum(),
                 (0..8).map(|i| (p[i] - c) * r[i].y).sum(),

@@ -68,7 +68,7 @@ impl TissueMetrics {
                 let c = p.iter().copied().sum::<Vec3>() / 8.0;
                 let d = p.map(|q| q - c);
                 let r = fat.rest_relative(e);
-                let a = covariance(&d, r);
+                let a = covariance(&d, &r);
                 // After an update the solver's rotation is warm: two trigonometry-free
                 // steps reach float precision. A hand-made state may be far from it.
                 let q = if only.is_some() {
