@@ -29,14 +29,19 @@ fn best_of<T>(n: usize, mut f: impl FnMut() -> Result<T>) -> Result<(f64, T)> {
     Ok((best, out.ok_or_else(|| anyhow::anyhow!("no run"))?))
 }
 
-fn fat_case(name: &'static str, dims: (usize, usize, usize), iters: usize) -> Result<Case> {
+fn fat_case(
+    name: &'static str,
+    dims: (usize, usize, usize),
+    iters: usize,
+    runs: usize,
+) -> Result<Case> {
     let mut s = FatSolver::grid(dims.0, dims.1, dims.2, 0.01);
     // Bend it a little so the rotations are not trivial.
     for p in &mut s.x {
         p.z += 0.02 * (p.x * 10.0).sin();
     }
     let n = s.len();
-    let (t, _) = best_of(3, || {
+    let (t, _) = best_of(runs, || {
         for _ in 0..iters {
             s.iterate(0.5);
         }
@@ -55,11 +60,17 @@ fn fat_case(name: &'static str, dims: (usize, usize, usize), iters: usize) -> Re
     })
 }
 
-fn knee_case(name: &'static str, tissue: bool, muscles: &[&str], note: &str) -> Result<Case> {
+fn knee_case(
+    name: &'static str,
+    tissue: bool,
+    muscles: &[&str],
+    note: &str,
+    runs: usize,
+) -> Result<Case> {
     let mut cfg = SimulationConfig::default();
     cfg.tissue.enabled = tissue;
     let base = Simulation::phantom(cfg)?;
-    let (t, angle) = best_of(3, || {
+    let (t, angle) = best_of(runs, || {
         let mut s = base.clone();
         for m in muscles {
             s.set_excitation(m, 0.6)?;
@@ -77,23 +88,40 @@ fn knee_case(name: &'static str, tissue: bool, muscles: &[&str], note: &str) -> 
     })
 }
 
-/// Runs every case and prints the table (or JSON).
-pub fn run(as_json: bool, vh: Option<&Path>) -> Result<()> {
+/// What `myoslice bench` runs and how it prints.
+#[derive(Debug, Clone)]
+pub struct BenchOptions<'a> {
+    /// JSON instead of a table.
+    pub json: bool,
+    /// The Visible Human folder, to time its build too.
+    pub visible_human: Option<&'a Path>,
+    /// Only the cases whose name contains this.
+    pub only: Option<&'a str>,
+    /// Runs per case (the best is reported).
+    pub runs: usize,
+}
+
+/// Runs every case (or those `only` names) and prints the table (or JSON).
+pub fn run(o: &BenchOptions) -> Result<()> {
+    let wanted = |name: &str| o.only.is_none_or(|w| name.contains(w));
+    let runs = o.runs.max(1);
     let mut cases = Vec::new();
-    let (t, lat) = best_of(3, || {
-        let (v, tb) = Phantom::default().generate()?;
-        Ok(Lattice::build(&v, &tb, &BuildOptions::default())?)
-    })?;
-    cases.push(Case {
-        name: "build_phantom",
-        seconds: t,
-        per_unit_ns: None,
-        unit: "s",
-        realtime_factor: None,
-        note: format!("generate + build, {} fat hexahedra", lat.fat.hexes.len()),
-    });
-    if let Some(dir) = vh {
-        let (t, lat) = best_of(3, || {
+    if wanted("build_phantom") {
+        let (t, lat) = best_of(runs, || {
+            let (v, tb) = Phantom::default().generate()?;
+            Ok(Lattice::build(&v, &tb, &BuildOptions::default())?)
+        })?;
+        cases.push(Case {
+            name: "build_phantom",
+            seconds: t,
+            per_unit_ns: None,
+            unit: "s",
+            realtime_factor: None,
+            note: format!("generate + build, {} fat hexahedra", lat.fat.hexes.len()),
+        });
+    }
+    if let Some(dir) = o.visible_human.filter(|_| wanted("build_visible_human")) {
+        let (t, lat) = best_of(runs, || {
             let v = read_nifti(dir.join("vhf_left_leg_labels.nii.gz"))?;
             let tb = LabelTable::from_path(dir.join("vhf_left_leg_labels.json"))?;
             Ok(Lattice::build(&v, &tb, &BuildOptions::default())?)
@@ -119,21 +147,40 @@ pub fn run(as_json: bool, vh: Option<&Path>) -> Result<()> {
         "popliteus",
         "plantaris",
     ];
-    cases.push(knee_case(
-        "knee_hinge_16",
-        false,
-        &FLEXORS,
-        "all muscles, the 10 flexors excited at 0.6, Hill, 1 ms, no tissue",
-    )?);
-    cases.push(fat_case("fat_kernel_840", (20, 7, 6), 2000)?);
-    cases.push(fat_case("fat_kernel_20k", (40, 25, 20), 100)?);
-    cases.push(fat_case("fat_kernel_200k", (100, 50, 40), 10)?);
-    cases.push(knee_case(
-        "whole_leg_step",
-        true,
-        &FLEXORS,
-        "all muscles, tissue at 30 Hz x 6 iterations, 1 ms",
-    )?);
+    if wanted("knee_hinge_16") {
+        cases.push(knee_case(
+            "knee_hinge_16",
+            false,
+            &FLEXORS,
+            "all muscles, the 10 flexors excited at 0.6, Hill, 1 ms, no tissue",
+            runs,
+        )?);
+    }
+    for (name, dims, iters) in [
+        ("fat_kernel_840", (20, 7, 6), 2000),
+        ("fat_kernel_20k", (40, 25, 20), 100),
+        ("fat_kernel_200k", (100, 50, 40), 10),
+    ] {
+        if wanted(name) {
+            cases.push(fat_case(name, dims, iters, runs)?);
+        }
+    }
+    if wanted("whole_leg_step") {
+        cases.push(knee_case(
+            "whole_leg_step",
+            true,
+            &FLEXORS,
+            "all muscles, tissue at 30 Hz x 6 iterations, 1 ms",
+            runs,
+        )?);
+    }
+    if cases.is_empty() {
+        anyhow::bail!(
+            "no benchmark case matches '{}' (cases: build_phantom, build_visible_human, \
+             knee_hinge_16, fat_kernel_840, fat_kernel_20k, fat_kernel_200k, whole_leg_step)",
+            o.only.unwrap_or_default()
+        );
+    }
     let machine = machine();
     let date = std::process::Command::new("date")
         .arg("-u")
@@ -141,7 +188,7 @@ pub fn run(as_json: bool, vh: Option<&Path>) -> Result<()> {
         .output()
         .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
         .unwrap_or_default();
-    if as_json {
+    if o.json {
         let v = json!({
             "machine": machine,
             "date": date,

@@ -60,6 +60,12 @@ struct BenchArgs {
     /// Also time the Visible Human build from ../shared/data (path to the folder).
     #[arg(long)]
     visible_human: Option<PathBuf>,
+    /// Run only the cases whose name contains this (e.g. `whole_leg` under a profiler).
+    #[arg(long)]
+    only: Option<String>,
+    /// Runs of each case; the fastest is reported.
+    #[arg(long, default_value_t = 3)]
+    runs: usize,
 }
 
 #[derive(Args)]
@@ -352,7 +358,12 @@ fn run(cli: &Cli) -> Result<()> {
     match &cli.command {
         Command::Build(a) => build(a),
         Command::Run(a) => run_scenario(a),
-        Command::Bench(a) => bench::run(a.json, a.visible_human.as_deref()),
+        Command::Bench(a) => bench::run(&bench::BenchOptions {
+            json: a.json,
+            visible_human: a.visible_human.as_deref(),
+            only: a.only.as_deref(),
+            runs: a.runs,
+        }),
         Command::Probe(a) => probe(a),
         Command::Slices(a) => {
             let (vol, table, _) = load(&a.model)?;

@@ -162,6 +162,10 @@ impl Skeleton {
             .ok_or_else(|| Error::Build("rapier refused the knee joint".into()))?;
         let params = IntegrationParameters {
             dt: 1e-3,
+            // One solver pass per 1 ms step: a single joint limit is the only constraint,
+            // and rapier's default of four substeps quadruples the multibody work for no
+            // accuracy the motion tests can see (pendulum period, energy, limits).
+            num_solver_iterations: 1,
             ..IntegrationParameters::default()
         };
         let mut sk = Self {

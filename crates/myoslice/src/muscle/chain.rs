@@ -3,7 +3,7 @@
 //! fixed to the bones. Interior points are kept in cones anchored on the bone surface
 //! (section 4.1, Fig. 6).
 
-use glam::{Quat, Vec3};
+use glam::{Mat3, Quat, Vec3};
 
 use super::wrap::{WrapCylinder, WrapPath};
 use crate::body::BodyId;
@@ -100,7 +100,7 @@ impl BodyFrames {
 }
 
 /// Per-segment geometry of the current chain.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SegmentGeom {
     /// Length along the path (m).
     pub length: f32,
@@ -145,6 +145,9 @@ pub struct MuscleChain {
     pub scratch: ChainScratch,
     /// Geometry of every segment at the current positions (see [`Self::refresh`]).
     pub geom: Vec<SegmentGeom>,
+    /// The body each point moves with (see [`Self::index_bodies`]): fixed once the chain
+    /// is built, looked up every step.
+    pub bodies: Vec<BodyId>,
 }
 
 /// Work buffers of [`MuscleChain::advance`], kept to avoid allocating every step.
@@ -152,13 +155,24 @@ pub struct MuscleChain {
 pub struct ChainScratch {
     f: Vec<Vec3>,
     kseg: Vec<f32>,
-    diag: Vec<f32>,
-    lower: Vec<f32>,
-    upper: Vec<f32>,
-    rhs: Vec<Vec3>,
     c: Vec<f32>,
     d: Vec<Vec3>,
     dv: Vec<Vec3>,
+}
+
+impl ChainScratch {
+    /// Every buffer at length `n` (contents are overwritten before use).
+    fn fit(&mut self, n: usize) {
+        if self.f.len() == n {
+            return;
+        }
+        for v in [&mut self.kseg, &mut self.c] {
+            v.resize(n, 0.0);
+        }
+        for v in [&mut self.f, &mut self.d, &mut self.dv] {
+            v.resize(n, Vec3::ZERO);
+        }
+    }
 }
 
 /// Forces of one chain step on its end points (world force, world point).
@@ -196,6 +210,7 @@ impl MuscleChain {
     }
 
     /// Geometry of segment `i` at the positions of the last [`Self::refresh`].
+    #[inline]
     pub fn segment(&self, i: usize) -> SegmentGeom {
         self.geom
             .get(i)
@@ -205,11 +220,59 @@ impl MuscleChain {
 
     /// Recomputes the cached segment geometry (after moving points).
     pub fn refresh(&mut self) {
+        self.refresh_geometry(false);
+    }
+
+    /// The segment geometry; with `update_wrap`, the wrapped state of the knee-crossing
+    /// segment follows the new positions too. One wrap evaluation serves both: the
+    /// geometry of `path(a, b, was)` equals that of `path(a, b, path(a, b, was).wrapped)`.
+    fn refresh_geometry(&mut self, update_wrap: bool) {
         let n = self.x.len().saturating_sub(1);
-        let mut geom = std::mem::take(&mut self.geom);
-        geom.clear();
-        geom.extend((0..n).map(|i| self.compute_segment(i)));
-        self.geom = geom;
+        self.geom.resize(n, SegmentGeom::default());
+        for i in 0..n {
+            self.refresh_segment(i, update_wrap);
+        }
+    }
+
+    #[inline]
+    fn refresh_segment(&mut self, i: usize, update_wrap: bool) {
+        self.geom[i] = if i == self.wrap_segment
+            && let Some(w) = &self.wrap
+        {
+            let path = w.path(self.x[i], self.x[i + 1], self.wrapped);
+            if update_wrap {
+                self.wrapped = path.wrapped;
+            }
+            SegmentGeom {
+                length: path.length,
+                dir_a: path.dir_p,
+                dir_b: path.dir_q,
+            }
+        } else {
+            straight_segment(self.x[i], self.x[i + 1])
+        };
+    }
+
+    /// The geometry after only the pinned points (ends, via points) moved: the segments
+    /// next to them. The rest is as the last refresh left it (every method that moves
+    /// interior points refreshes).
+    fn refresh_pinned(&mut self) {
+        let n = self.x.len();
+        if self.geom.len() + 1 != n {
+            self.refresh();
+            return;
+        }
+        // Ends and via points are the massless points.
+        for i in 0..n - 1 {
+            if self.mass[i] <= 0.0 || self.mass[i + 1] <= 0.0 {
+                self.refresh_segment(i, false);
+            }
+        }
+        debug_assert!(
+            !self.x.iter().all(|p| p.is_finite())
+                || (0..n - 1).all(|i| self.compute_segment(i) == self.geom[i]),
+            "interior chain points moved without a refresh"
+        );
     }
 
     /// Geometry of segment `i` (between points i and i+1); the knee-crossing one may wrap.
@@ -230,13 +293,7 @@ impl MuscleChain {
                 dir_b: dir_q,
             };
         }
-        let d = b - a;
-        let l = d.length().max(1e-9);
-        SegmentGeom {
-            length: l,
-            dir_a: d / l,
-            dir_b: -d / l,
-        }
+        straight_segment(a, b)
     }
 
     /// Path length origin to insertion (m), wrapping included.
@@ -249,6 +306,13 @@ impl MuscleChain {
     /// The body each point moves with: the attachment bodies at the ends, the cone's body
     /// for interior points.
     pub fn point_body(&self, i: usize) -> BodyId {
+        match self.bodies.get(i) {
+            Some(b) if self.bodies.len() == self.x.len() => *b,
+            _ => self.body_of_point(i),
+        }
+    }
+
+    fn body_of_point(&self, i: usize) -> BodyId {
         if i == 0 {
             self.origin.body
         } else if i + 1 == self.x.len() {
@@ -258,6 +322,12 @@ impl MuscleChain {
         } else {
             self.cones[i].map_or(self.origin.body, |c| c.body)
         }
+    }
+
+    /// Fills [`Self::bodies`] from the attachments, via points and cones (call after
+    /// changing any of them).
+    pub fn index_bodies(&mut self) {
+        self.bodies = (0..self.x.len()).map(|i| self.body_of_point(i)).collect();
     }
 
     /// Path lengthening velocity (m/s) due to the bones' motion alone: every point moving
@@ -282,13 +352,10 @@ impl MuscleChain {
             .sum()
     }
 
-    /// Updates whether the knee-crossing segment is wrapped (call after points move).
+    /// Updates whether the knee-crossing segment is wrapped, and the segment geometry
+    /// (call after points move).
     pub fn update_wrap(&mut self) {
-        if let Some(w) = &self.wrap {
-            let i = self.wrap_segment;
-            self.wrapped = w.path(self.x[i], self.x[i + 1], self.wrapped).wrapped;
-        }
-        self.refresh();
+        self.refresh_geometry(true);
     }
 
     /// Moves the end points onto their attachments.
@@ -301,6 +368,9 @@ impl MuscleChain {
         }
     }
 
+    /// Tension of segment `i` (N, positive pulling its ends together) and its axial
+    /// spring constant (N/m).
+    #[inline]
     fn tension(
         &self,
         i: usize,
@@ -308,28 +378,36 @@ impl MuscleChain {
         load: &ChainLoad,
         belly_scale: f32,
         damping: f32,
-    ) -> f32 {
+    ) -> (f32, f32) {
         let rate = -(self.v[i].dot(g.dir_a) + self.v[i + 1].dot(g.dir_b));
-        let k = load.stiffness / self.rest_len[i].max(5e-3);
-        let spring = if load.neutral_springs {
-            if self.tendon[i] {
+        let rest = self.rest_len[i];
+        let (k, neutral) = if load.neutral_springs {
+            // Hill mode: tendons carry no spring; belly springs only spread the points.
+            let k = if self.tendon[i] {
                 0.0
             } else {
-                k * (g.length - self.rest_len[i] * belly_scale)
-            }
+                load.stiffness / rest.max(5e-3)
+            };
+            (k, rest * belly_scale)
         } else {
-            k * (g.length - self.rest_len[i])
+            (load.stiffness / rest.max(5e-3), rest)
         };
-        spring + damping * rate + load.contraction
+        (
+            k * (g.length - neutral) + damping * rate + load.contraction,
+            k,
+        )
     }
 
     /// Whether every point of the chain moves with one body (no knee crossing, no cone on
     /// the other body): then an unloaded chain is carried rigidly.
     pub fn single_body(&self) -> Option<BodyId> {
         let b = self.origin.body;
-        (0..self.x.len())
-            .all(|i| self.point_body(i) == b)
-            .then_some(b)
+        let on_b = if self.bodies.len() == self.x.len() {
+            self.bodies.iter().all(|&p| p == b)
+        } else {
+            (0..self.x.len()).all(|i| self.body_of_point(i) == b)
+        };
+        on_b.then_some(b)
     }
 
     /// Carries the whole chain rigidly with body `b` from `from` to `to`.
@@ -346,36 +424,98 @@ impl MuscleChain {
             self.v.iter_mut().for_each(|v| *v = Vec3::ZERO);
             return;
         }
-        let inv = q0.inverse();
+        // The rigid motion from one pose to the other, composed once.
+        let q = q1 * q0.inverse();
+        let t = t1 - q * t0;
+        let (m, inv_dt) = (Mat3::from_quat(q), 1.0 / dt);
         for i in 0..self.x.len() {
-            let rest = inv * (self.x[i] - t0);
-            let p = to.point(b, rest);
-            self.v[i] = (p - self.x[i]) / dt;
+            let p = m * self.x[i] + t;
+            self.v[i] = (p - self.x[i]) * inv_dt;
             self.x[i] = p;
         }
         self.refresh();
     }
 
-    /// Advances the interior points by `dt` while the bodies move from `from` to `to`:
+    /// Advances the interior points by `dt` while the bodies move to `to`:
     /// Eq. 1 with gravity, integrated by linearly implicit (backward) Euler so that stiff
     /// springs and large contraction forces stay stable at the 1 kHz step, then the cone
-    /// projection. Returns the number of substeps taken.
-    pub fn advance(
-        &mut self,
-        dt: f32,
-        from: &BodyFrames,
-        to: &BodyFrames,
-        load: &ChainLoad,
-    ) -> usize {
+    /// projection. Returns the number of substeps taken (one: backward Euler is stable at
+    /// any step).
+    pub fn advance(&mut self, dt: f32, to: &BodyFrames, load: &ChainLoad) -> usize {
         let n = self.x.len();
         if n < 3 {
             self.attach_ends(to);
             return 0;
         }
-        // Backward Euler is stable at any step; two substeps keep the linearisation
-        // accurate when the chain swings fast.
-        let subs = 1;
-        let h = dt / subs as f32;
+        let h = dt;
+        let damping = self.critical_damping(load);
+        let mut sc = std::mem::take(&mut self.scratch);
+        sc.fit(n);
+        // The pinned points move with their bodies; their velocity is that motion.
+        let old_ends = (self.x[0], self.x[n - 1]);
+        self.x[0] = to.point(self.origin.body, self.origin.rest);
+        self.x[n - 1] = to.point(self.insertion.body, self.insertion.rest);
+        self.v[0] = (self.x[0] - old_ends.0) / h;
+        self.v[n - 1] = (self.x[n - 1] - old_ends.1) / h;
+        for (i, a) in &self.vias {
+            let p = to.point(a.body, a.rest);
+            self.v[*i] = (p - self.x[*i]) / h;
+            self.x[*i] = p;
+        }
+        self.refresh_pinned();
+        let belly_scale = if load.neutral_springs {
+            self.belly_length() / self.belly_rest.max(1e-6)
+        } else {
+            1.0
+        };
+        sc.f.iter_mut().for_each(|v| *v = Vec3::ZERO);
+        for i in 0..n - 1 {
+            let g = self.geom[i];
+            let (t, k_ax) = self.tension(i, &g, load, belly_scale, damping);
+            sc.f[i] += g.dir_a * t;
+            sc.f[i + 1] += g.dir_b * t;
+            // Isotropic bound of the segment stiffness: the axial spring or the transverse
+            // stiffness of a string under tension (never negative), whichever is larger; a
+            // scalar tridiagonal system, slightly over-damping the softer direction,
+            // stable for any step.
+            sc.kseg[i] = k_ax.max(t.max(0.0) / g.length.max(1e-4));
+        }
+        for i in 1..n - 1 {
+            if self.mass[i] > 0.0 {
+                sc.f[i] += load.gravity * self.mass[i];
+            }
+        }
+        self.solve_implicit(h, damping, &mut sc);
+        // The cones move with their bodies: each rotation as a matrix, built once.
+        let thigh = (Mat3::from_quat(to.thigh.0), to.thigh.1);
+        let shank = (Mat3::from_quat(to.shank.0), to.shank.1);
+        for i in 1..n - 1 {
+            if self.mass[i] <= 0.0 {
+                continue; // pinned via point
+            }
+            let old = self.x[i];
+            self.v[i] += sc.dv[i];
+            self.x[i] += self.v[i] * h;
+            if let Some(c) = self.cones[i] {
+                let (m, t) = match c.body {
+                    BodyId::Thigh => thigh,
+                    BodyId::Shank => shank,
+                };
+                let (apex, axis) = (m * c.apex + t, m * c.axis);
+                let p = project_into_cone(self.x[i], apex, axis, self.cone_cos_tan);
+                self.x[i] = clamp_depth(p, apex, c.depth);
+                // Position-based correction: the velocity follows the projected motion.
+                self.v[i] = (self.x[i] - old) / h;
+            }
+        }
+        self.update_wrap();
+        self.scratch = sc;
+        1
+    }
+
+    /// Critical damping of the stiffest mode of the lightest point.
+    fn critical_damping(&self, load: &ChainLoad) -> f32 {
+        let n = self.x.len();
         let m_min = self.mass[1..n - 1]
             .iter()
             .copied()
@@ -389,74 +529,7 @@ impl MuscleChain {
             .fold(f32::INFINITY, f32::min)
             .max(5e-3);
         let k_max = load.stiffness / l_min + load.contraction.abs() / l_min;
-        // Critical damping of the stiffest mode of the lightest point.
-        let damping = (k_max * m_min).sqrt();
-        let mut sc = std::mem::take(&mut self.scratch);
-        sc.f.resize(n, Vec3::ZERO);
-        sc.kseg.resize(n, 0.0);
-        for s in 0..subs {
-            let (f, kseg) = (&mut sc.f, &mut sc.kseg);
-            let fr = from.lerp(to, (s + 1) as f32 / subs as f32);
-            let old_ends = (self.x[0], self.x[n - 1]);
-            let old_vias: Vec<Vec3> = self.vias.iter().map(|(i, _)| self.x[*i]).collect();
-            self.attach_ends(&fr);
-            self.v[0] = (self.x[0] - old_ends.0) / h;
-            self.v[n - 1] = (self.x[n - 1] - old_ends.1) / h;
-            for ((i, _), o) in self.vias.iter().zip(&old_vias) {
-                self.v[*i] = (self.x[*i] - *o) / h;
-            }
-            self.refresh();
-            let belly_scale = if load.neutral_springs {
-                self.belly_length() / self.belly_rest.max(1e-6)
-            } else {
-                1.0
-            };
-            f.iter_mut().for_each(|v| *v = Vec3::ZERO);
-            for i in 0..n - 1 {
-                let g = self.segment(i);
-                let t = self.tension(i, &g, load, belly_scale, damping);
-                f[i] += g.dir_a * t;
-                f[i + 1] += g.dir_b * t;
-                // Stiffness of the segment: axial spring plus the transverse stiffness of
-                // a string under tension (never negative, for stability).
-                let u = g.dir_a;
-                let k_ax = if load.neutral_springs && self.tendon[i] {
-                    0.0
-                } else {
-                    load.stiffness / self.rest_len[i].max(5e-3)
-                };
-                let t_l = (t.max(0.0)) / g.length.max(1e-4);
-                // Isotropic bound of the segment stiffness: a scalar tridiagonal system,
-                // slightly over-damping the softer direction, stable for any step.
-                let _ = u;
-                kseg[i] = k_ax.max(t_l);
-            }
-            for i in 1..n - 1 {
-                if self.mass[i] > 0.0 {
-                    f[i] += load.gravity * self.mass[i];
-                }
-            }
-            self.solve_implicit(h, damping, &mut sc);
-            for i in 1..n - 1 {
-                if self.mass[i] <= 0.0 {
-                    continue; // pinned via point
-                }
-                let old = self.x[i];
-                self.v[i] += sc.dv[i];
-                self.x[i] += self.v[i] * h;
-                if let Some(c) = self.cones[i] {
-                    let apex = fr.point(c.body, c.apex);
-                    let axis = fr.vector(c.body, c.axis);
-                    let p = project_into_cone(self.x[i], apex, axis, self.cone_cos_tan);
-                    self.x[i] = clamp_depth(p, apex, c.depth);
-                    // Position-based correction: the velocity follows the projected motion.
-                    self.v[i] = (self.x[i] - old) / h;
-                }
-            }
-            self.update_wrap();
-        }
-        self.scratch = sc;
-        subs
+        (k_max * m_min).sqrt()
     }
 
     /// Solves `(M + h·D + h²·K) Δv = h (f + h·K·v)` over the interior points, with the
@@ -464,40 +537,31 @@ impl MuscleChain {
     /// `sc.dv`.
     fn solve_implicit(&self, h: f32, damping: f32, sc: &mut ChainScratch) {
         let n = self.x.len();
-        for v in [&mut sc.diag, &mut sc.lower, &mut sc.upper, &mut sc.c] {
-            v.clear();
-            v.resize(n, 0.0);
-        }
-        for v in [&mut sc.rhs, &mut sc.d, &mut sc.dv] {
-            v.clear();
-            v.resize(n, Vec3::ZERO);
-        }
-        let (f, kseg) = (&sc.f, &sc.kseg);
-        sc.diag.iter_mut().for_each(|d| *d = 1.0);
+        let pinned = |j: usize| j == 0 || j == n - 1 || self.mass[j] <= 0.0;
         let dmp = h * damping;
+        let hh = h * h;
+        // Forward elimination (Thomas) while the rows are built; row 0 and n − 1 are
+        // pinned (Δv = 0).
+        sc.c[0] = 0.0;
+        sc.d[0] = Vec3::ZERO;
         for i in 1..n - 1 {
-            let m = self.mass[i];
-            if m <= 0.0 {
-                continue;
-            }
-            let (kl, kr) = (kseg[i - 1], kseg[i]);
-            sc.diag[i] = m + 2.0 * dmp + (kl + kr) * h * h;
-            let pinned = |j: usize| j == 0 || j == n - 1 || self.mass[j] <= 0.0;
-            if !pinned(i - 1) {
-                sc.lower[i] = -dmp - kl * h * h;
-            }
-            if !pinned(i + 1) {
-                sc.upper[i] = -dmp - kr * h * h;
-            }
-            let kv = (self.v[i - 1] - self.v[i]) * kl + (self.v[i + 1] - self.v[i]) * kr;
-            sc.rhs[i] = (f[i] + kv * h) * h;
+            let (kl, kr) = (sc.kseg[i - 1], sc.kseg[i]);
+            let (diag, lower, upper, rhs) = if pinned(i) {
+                (1.0, 0.0, 0.0, Vec3::ZERO)
+            } else {
+                let kv = (self.v[i - 1] - self.v[i]) * kl + (self.v[i + 1] - self.v[i]) * kr;
+                (
+                    self.mass[i] + 2.0 * dmp + (kl + kr) * hh,
+                    if pinned(i - 1) { 0.0 } else { -dmp - kl * hh },
+                    if pinned(i + 1) { 0.0 } else { -dmp - kr * hh },
+                    (sc.f[i] + kv * h) * h,
+                )
+            };
+            let inv = 1.0 / (diag - lower * sc.c[i - 1]);
+            sc.c[i] = inv * upper;
+            sc.d[i] = (rhs - sc.d[i - 1] * lower) * inv;
         }
-        // Thomas algorithm.
-        for i in 1..n - 1 {
-            let inv = 1.0 / (sc.diag[i] - sc.lower[i] * sc.c[i - 1]);
-            sc.c[i] = inv * sc.upper[i];
-            sc.d[i] = (sc.rhs[i] - sc.d[i - 1] * sc.lower[i]) * inv;
-        }
+        sc.dv[n - 1] = Vec3::ZERO;
         for i in (1..n - 1).rev() {
             let v = sc.d[i] - sc.dv[i + 1] * sc.c[i];
             sc.dv[i] = if v.is_finite() { v } else { Vec3::ZERO };
@@ -516,7 +580,7 @@ impl MuscleChain {
             gravity,
         };
         for _ in 0..200 {
-            self.advance(1e-3, frames, frames, &load);
+            self.advance(1e-3, frames, &load);
             for v in &mut self.v {
                 *v *= 0.5;
             }
@@ -536,8 +600,8 @@ impl MuscleChain {
     pub fn end_forces(&self, load: &ChainLoad) -> EndForces {
         let n = self.x.len();
         let (g0, g1) = (self.segment(0), self.segment(n - 2));
-        let t0 = self.tension(0, &g0, load, 1.0, 0.0);
-        let t1 = self.tension(n - 2, &g1, load, 1.0, 0.0);
+        let (t0, _) = self.tension(0, &g0, load, 1.0, 0.0);
+        let (t1, _) = self.tension(n - 2, &g1, load, 1.0, 0.0);
         EndForces {
             origin: g0.dir_a * t0,
             insertion: g1.dir_b * t1,
@@ -545,10 +609,27 @@ impl MuscleChain {
     }
 }
 
+/// The straight segment from `a` to `b`.
+fn straight_segment(a: Vec3, b: Vec3) -> SegmentGeom {
+    let d = b - a;
+    let l = d.length().max(1e-9);
+    let dir = d * (1.0 / l);
+    SegmentGeom {
+        length: l,
+        dir_a: dir,
+        dir_b: -dir,
+    }
+}
+
 /// `p` moved along the line from `apex` so that its distance from it lies in `depth`.
 pub fn clamp_depth(p: Vec3, apex: Vec3, depth: [f32; 2]) -> Vec3 {
     let w = p - apex;
-    let d = w.length();
+    // Inside the shell (the usual case) without a square root.
+    let d2 = w.length_squared();
+    if d2 >= depth[0] * depth[0] && d2 <= depth[1] * depth[1] {
+        return p;
+    }
+    let d = d2.sqrt();
     if d < 1e-9 {
         return p;
     }
@@ -562,10 +643,12 @@ pub fn project_into_cone(p: Vec3, apex: Vec3, axis: Vec3, (cos_a, tan_a): (f32, 
     let w = p - apex;
     let t = w.dot(axis);
     let radial = w - axis * t;
-    let r = radial.length();
-    if t > 0.0 && r <= t * tan_a {
+    // Inside (the usual case) without a square root.
+    let r2 = radial.length_squared();
+    if t > 0.0 && r2 <= (t * tan_a) * (t * tan_a) {
         return p;
     }
+    let r = r2.sqrt();
     let sin_a = cos_a * tan_a;
     let s = t * cos_a + r * sin_a;
     if s <= 0.0 {

@@ -35,13 +35,18 @@ impl MuscleChain {
     /// Moment arm (m) about `axis` of the path when `moving` turns about it:
     /// −dL/dθ, positive when the path shortens as the body turns positively.
     pub fn moment_arm(&self, axis: &Axis, moving: BodyId) -> f64 {
-        -self.anchored_path_velocity(|b, p| {
-            if b == moving {
-                axis.dir.cross(p - axis.point)
-            } else {
-                Vec3::ZERO
+        // Σ over segments of the rate its ends separate when `moving` turns at unit rate.
+        let mut rate = 0.0f32;
+        for i in 0..self.x.len().saturating_sub(1) {
+            let g = self.segment(i);
+            if self.point_body(i) == moving {
+                rate -= axis.dir.cross(self.x[i] - axis.point).dot(g.dir_a);
             }
-        })
+            if self.point_body(i + 1) == moving {
+                rate -= axis.dir.cross(self.x[i + 1] - axis.point).dot(g.dir_b);
+            }
+        }
+        -f64::from(rate)
     }
 
     /// The chain's pulls on `body` per unit tension: one at the `body` end of each segment

@@ -22,6 +22,8 @@ const FL: [[f64; 4]; 3] = [
 /// Passive force-length: shape factor and strain at one normalised force.
 const K_PE: f64 = 4.0;
 const E0: f64 = 0.6;
+/// exp(K_PE) − 1, the passive curve's normaliser (so that it reaches 1 at 1 + E0).
+const PASSIVE_SCALE: f64 = 53.598_150_033_144_236;
 /// Force-velocity coefficients.
 const D1: f64 = -0.318_323_436_899_127;
 const D2: f64 = -8.149_156_043_475_250;
@@ -45,7 +47,7 @@ pub fn active_force_length(l: f64) -> f64 {
 
 /// Passive force-length multiplier (slightly negative below optimal length, as published).
 pub fn passive_force_length(l: f64) -> f64 {
-    ((K_PE * (l - 1.0) / E0).exp() - 1.0) / (K_PE.exp() - 1.0)
+    ((K_PE * (l - 1.0) / E0).exp() - 1.0) / PASSIVE_SCALE
 }
 
 /// Force-velocity multiplier at normalised fibre velocity `v` (lengths of optimal fibre
@@ -128,10 +130,13 @@ impl HillParams {
     pub fn force(&self, a: f64, fibre: &FibreState) -> HillForce {
         let l = fibre.length / self.optimal_fibre_length;
         let v = fibre.velocity / (self.max_contraction_velocity * self.optimal_fibre_length);
-        let fl = active_force_length(l);
-        let fv = force_velocity(v.clamp(-1.0, 1.0));
         let fpe = passive_force_length(l);
-        let active = a * fl * fv;
+        // An inactive fibre skips the active curves (exactly: they are finite).
+        let active = if a > 0.0 {
+            a * active_force_length(l) * force_velocity(v.clamp(-1.0, 1.0))
+        } else {
+            0.0
+        };
         let fibre_force = self.max_isometric_force * (active + fpe + self.fibre_damping * v);
         HillForce {
             tendon: (fibre_force * fibre.cos_pennation).max(0.0),
@@ -172,6 +177,11 @@ pub struct HillForce {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_passive_normaliser_is_exp_k_pe_minus_one() {
+        assert!((PASSIVE_SCALE - (K_PE.exp() - 1.0)).abs() < 1e-12);
+    }
 
     #[test]
     fn curves_have_their_landmarks() {

@@ -68,8 +68,11 @@ pub struct MuscleUnit {
     pub force: f64,
     /// Fibre state of the last step.
     pub fibre: FibreState,
-    /// Moment arm about the knee (m), positive for flexion.
+    /// Moment arm about the knee (m), positive for flexion, of the last step (the one its
+    /// force and the knee torque went with).
     pub moment_arm: f64,
+    /// Moment arm at the chain's current geometry (m): the next step's.
+    pub current_moment_arm: f64,
 }
 
 fn bone_index(lattice: &Lattice, name: &str) -> Option<usize> {
@@ -306,7 +309,9 @@ impl MuscleUnit {
             belly_rest,
             scratch: Default::default(),
             geom: Vec::new(),
+            bodies: Vec::new(),
         };
+        chain.index_bodies();
         let explicit_wrap = entry.and_then(|e| e.wrap_radius_m).is_some();
         if crosses_knee && (explicit_wrap || wrap_fits(&chain, knee)) {
             // The segment crossing the knee: from the last point moving with the origin's
@@ -382,6 +387,7 @@ impl MuscleUnit {
             force: 0.0,
             fibre,
             moment_arm: 0.0,
+            current_moment_arm: 0.0,
         })
     }
 

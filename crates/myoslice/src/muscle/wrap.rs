@@ -38,7 +38,11 @@ impl WrapCylinder {
     }
 
     fn planar(&self, p: Vec3) -> (DVec2, f32) {
-        let (e1, e2) = self.basis();
+        self.planar_in(self.basis(), p)
+    }
+
+    /// `p` in the plane across the axis (basis `e`) and its height along it.
+    fn planar_in(&self, (e1, e2): (Vec3, Vec3), p: Vec3) -> (DVec2, f32) {
         let d = p - self.point;
         (
             DVec2::new(f64::from(d.dot(e1)), f64::from(d.dot(e2))),
@@ -46,8 +50,7 @@ impl WrapCylinder {
         )
     }
 
-    fn spatial(&self, q: DVec2, h: f32) -> Vec3 {
-        let (e1, e2) = self.basis();
+    fn spatial_in(&self, (e1, e2): (Vec3, Vec3), q: DVec2, h: f32) -> Vec3 {
         self.point + e1 * q.x as f32 + e2 * q.y as f32 + self.axis * h
     }
 
@@ -87,8 +90,9 @@ impl WrapCylinder {
                 wrapped: false,
             }
         };
-        let (a, ha) = self.planar(p);
-        let (b, hb) = self.planar(q);
+        let e = self.basis();
+        let (a, ha) = self.planar_in(e, p);
+        let (b, hb) = self.planar_in(e, q);
         let r = f64::from(self.radius);
         let (da, db) = (a.length(), b.length());
         if r <= 0.0 || da <= r * 1.0001 || db <= r * 1.0001 {
@@ -122,7 +126,7 @@ impl WrapCylinder {
         // Along the axis the path climbs linearly with its length.
         let h1 = ha + (hb - ha) * (l1 / total) as f32;
         let h2 = ha + (hb - ha) * ((l1 + l2) / total) as f32;
-        let (p1, p2) = (self.spatial(t1, h1), self.spatial(t2, h2));
+        let (p1, p2) = (self.spatial_in(e, t1, h1), self.spatial_in(e, t2, h2));
         let planar = l1 + l2 + l3;
         let length = (planar * planar + f64::from(hb - ha).powi(2)).sqrt() as f32;
         WrapPath {

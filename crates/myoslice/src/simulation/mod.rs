@@ -153,6 +153,8 @@ impl Simulation {
             tissue: None,
             scratch: Default::default(),
         };
+        // Moment arms and wrap state of the chains as built.
+        sim.reattach_muscles();
         if let Some(bones) = bones {
             // The tissue's rest is the chains' equilibrium at rest (see `settle`); the
             // simulation itself starts from the chains as built.
@@ -210,6 +212,7 @@ impl Simulation {
             m.path_velocity = 0.0;
             if m.crosses_knee {
                 m.moment_arm = m.chain.moment_arm(&axis, BodyId::Shank);
+                m.current_moment_arm = m.moment_arm;
             }
         }
     }
@@ -523,7 +526,10 @@ impl Simulation {
             return Some("knee angle".into());
         }
         for m in &self.muscles {
-            if !m.force.is_finite() || m.chain.x.iter().any(|p| !p.is_finite()) {
+            // A NaN or infinity anywhere makes the sum non-finite (positions are metres:
+            // no finite sum overflows); one branch per muscle instead of one per point.
+            let sum: Vec3 = m.chain.x.iter().copied().sum();
+            if !m.force.is_finite() || !sum.is_finite() {
                 return Some(format!("muscle {}", m.name));
             }
         }
@@ -541,10 +547,6 @@ impl Simulation {
         let frames = self.frames;
         let knee_point = frames.point(BodyId::Thigh, knee.point);
         let knee_dir = frames.vector(BodyId::Thigh, knee.axis);
-        let axis = Axis {
-            point: knee_point,
-            dir: knee_dir,
-        };
         for (m, sched) in self.muscles.iter_mut().zip(&self.schedules) {
             if let Some(s) = sched {
                 m.excitation = s.value(self.time);
@@ -616,7 +618,7 @@ impl Simulation {
                 }
             }
             m.moment_arm = if m.crosses_knee {
-                m.chain.moment_arm(&axis, BodyId::Shank)
+                m.current_moment_arm
             } else {
                 0.0
             };
@@ -625,7 +627,13 @@ impl Simulation {
         self.knee_torque = torque;
         self.skeleton.step(h, &forces);
         let next = self.current_frames();
-        let (shank_v, shank_w, shank_c) = self.skeleton.shank_motion();
+        // The thigh is fixed: the shank turns about the knee axis, so the path lengthens at
+        // −(moment arm) × knee velocity (virtual work).
+        let knee_velocity = self.skeleton.knee_velocity();
+        let axis = Axis {
+            point: next.point(BodyId::Thigh, knee.point),
+            dir: next.vector(BodyId::Thigh, knee.axis),
+        };
         for (m, load) in self.muscles.iter_mut().zip(&loads) {
             // A muscle at rest on one body is carried with it; only loaded or
             // knee-crossing chains need their dynamics.
@@ -635,7 +643,7 @@ impl Simulation {
             match m.chain.single_body() {
                 Some(b) if quiet => m.chain.carry(b, &frames, &next, h as f32),
                 _ => {
-                    m.chain.advance(h as f32, &frames, &next, load);
+                    m.chain.advance(h as f32, &next, load);
                 }
             }
             if hill {
@@ -649,15 +657,15 @@ impl Simulation {
                 m.activation = (m.activation + h * rate).clamp(0.0, 1.0);
             }
             m.path_length = m.chain.path_length();
-            m.path_velocity = if m.crosses_knee {
-                m.chain.anchored_path_velocity(|b, p| match b {
-                    BodyId::Thigh => Vec3::ZERO,
-                    BodyId::Shank => shank_v + shank_w.cross(p - shank_c),
-                })
+            if m.crosses_knee {
+                // Computed once per step on the new geometry; the next step's torque
+                // report and the fibre velocity both use it.
+                m.current_moment_arm = m.chain.moment_arm(&axis, BodyId::Shank);
+                m.path_velocity = -m.current_moment_arm * knee_velocity;
             } else {
                 // Both ends and every cone on one rigid body: no excursion.
-                0.0
-            };
+                m.path_velocity = 0.0;
+            }
         }
         self.frames = next;
         self.time += h;
