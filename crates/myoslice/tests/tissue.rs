@@ -45,7 +45,7 @@ fn rigid_motions_leave_no_deformation_and_no_area_change() {
     for (x, r) in t.fat.x.iter_mut().zip(&t.fat.rest) {
         *x = q * *r + shift;
     }
-    let m = TissueMetrics::measure(sim.lattice(), &t);
+    let m = TissueMetrics::measure(&t);
     let worst_degree = m.deformation_degree.iter().copied().fold(0.0f32, f32::max);
     let worst_area = m.area_change.iter().map(|a| a.abs()).fold(0.0f32, f32::max);
     assert!(
@@ -85,7 +85,7 @@ fn stretched_skin_shows_positive_area_change_and_compressed_skin_negative() {
             }
         }
     }
-    let m = TissueMetrics::measure(lat, &t);
+    let m = TissueMetrics::measure(&t);
     let outer = |s: usize, j: usize| m.area_change[fat.hex_index(s, j, fat.layers - 1) as usize];
     let grown = (0..fat.rays).filter(|&j| outer(40, j) > 0.05).count();
     let shrunk = (0..fat.rays).filter(|&j| outer(120, j) < -0.05).count();

@@ -127,6 +127,26 @@ pub fn hex_volume_points(p: &[DVec3; 8]) -> f64 {
     vol / 6.0
 }
 
+/// Signed volume of hexahedron `h` of `x` (VTK corner order), about its first corner in
+/// single precision: for the per-update checks, whose thresholds are percents of the
+/// rest volume.
+pub fn hex_volume_f32(x: &[Vec3], h: &[u32; 8]) -> f32 {
+    const TETS: [[usize; 3]; 6] = [
+        [1, 2, 6],
+        [2, 3, 6],
+        [3, 7, 6],
+        [7, 4, 6],
+        [4, 5, 6],
+        [5, 1, 6],
+    ];
+    let p0 = x[h[0] as usize];
+    let p = h.map(|i| glam::Vec3A::from(x[i as usize] - p0));
+    TETS.iter()
+        .map(|t| p[t[0]].dot(p[t[1]].cross(p[t[2]])))
+        .sum::<f32>()
+        / 6.0
+}
+
 /// Inputs of the fat build that come from the bone and muscle passes.
 pub(crate) struct FatInputs<'a> {
     pub stack: &'a SliceStack,

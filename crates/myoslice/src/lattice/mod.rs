@@ -12,7 +12,7 @@ use glam::Vec3;
 
 pub use builder::BuildOptions;
 pub use checks::{InvariantReport, oriented_trimesh, strictly_inside, winding_number};
-pub use fat::{FatLattice, InnerContact, hex_volume, hex_volume_points, quad_area};
+pub use fat::{FatLattice, InnerContact, hex_volume, hex_volume_f32, hex_volume_points, quad_area};
 pub use frame::SliceFrame;
 pub use tube::{Ring, RingInput, Slab, TubeMesh, check_closed, signed_volume};
 

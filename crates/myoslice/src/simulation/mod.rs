@@ -153,8 +153,6 @@ impl Simulation {
             tissue: None,
             scratch: Default::default(),
         };
-        // Moment arms and wrap state of the chains as built.
-        sim.reattach_muscles();
         if let Some(bones) = bones {
             // The tissue's rest is the chains' equilibrium at rest (see `settle`); the
             // simulation itself starts from the chains as built.
@@ -277,7 +275,7 @@ impl Simulation {
     pub fn update_tissue(&mut self) -> Result<()> {
         let angle = self.knee_angle();
         if let Some(t) = &mut self.tissue
-            && !t.update(&self.lattice, angle, &self.frames, &self.muscles)
+            && !t.update(angle, &self.frames, &self.muscles)
         {
             return Err(Error::NonFinite {
                 time: self.time,

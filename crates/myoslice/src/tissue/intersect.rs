@@ -2,6 +2,7 @@
 //! another one it shares no vertex with?
 
 use glam::{DVec3, UVec3, Vec3};
+use rayon::prelude::*;
 
 /// Number of pairs of triangles (sharing no vertex) whose interiors cross.
 pub fn self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> usize {
@@ -22,111 +23,256 @@ pub fn crossing_pairs_among(
     triangles: &[[u32; 3]],
     active: Option<&[bool]>,
 ) -> Vec<(u32, u32)> {
-    if triangles.is_empty() {
+    let boxes: Vec<Aabb> = triangles.iter().map(|t| Aabb::of(vertices, t)).collect();
+    let Some(grid) = TriangleGrid::new(&boxes, triangles, vertices) else {
         return Vec::new();
-    }
-    let corners = |t: &[u32; 3]| t.map(|i| vertices[i as usize].as_dvec3());
-    let bbox = |t: &[DVec3; 3]| (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
-    // With an active set, only triangles overlapping the active ones' box can matter.
-    let (ids, tri): (Vec<u32>, Vec<[DVec3; 3]>) = match active {
-        None => (0..triangles.len() as u32)
-            .zip(triangles.iter().map(corners))
-            .unzip(),
-        Some(a) => {
-            let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-            for (t, _) in triangles.iter().zip(a).filter(|(_, on)| **on) {
-                let b = bbox(&corners(t));
-                lo = lo.min(b.0);
-                hi = hi.max(b.1);
-            }
-            (0..triangles.len() as u32)
-                .zip(triangles.iter().map(corners))
-                .filter(|(_, t)| {
-                    let b = bbox(t);
-                    !(b.0.cmpgt(hi).any() || lo.cmpgt(b.1).any())
-                })
-                .unzip()
-        }
     };
-    if tri.is_empty() {
-        return Vec::new();
+    let is_active = |i: usize| active.is_none_or(|a| a[i]);
+    let query: Vec<u32> = (0..triangles.len() as u32)
+        .filter(|&i| is_active(i as usize))
+        .collect();
+    grid.crossing_pairs(vertices, triangles, &boxes, &query, |i| {
+        is_active(i as usize)
+    })
+}
+
+/// An axis-aligned box.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aabb {
+    /// Lower corner.
+    pub lo: Vec3,
+    /// Upper corner.
+    pub hi: Vec3,
+}
+
+impl Aabb {
+    /// The box of triangle `t`.
+    pub fn of(vertices: &[Vec3], t: &[u32; 3]) -> Self {
+        let [a, b, c] = t.map(|i| vertices[i as usize]);
+        Self {
+            lo: a.min(b).min(c),
+            hi: a.max(b).max(c),
+        }
     }
-    let boxes: Vec<(DVec3, DVec3)> = tri.iter().map(bbox).collect();
-    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-    let mut mean_edge = 0.0;
-    for (t, b) in tri.iter().zip(&boxes) {
-        lo = lo.min(b.0);
-        hi = hi.max(b.1);
-        mean_edge += (t[1] - t[0]).length();
+
+    /// The smallest box holding both.
+    pub fn union(&self, o: &Self) -> Self {
+        Self {
+            lo: self.lo.min(o.lo),
+            hi: self.hi.max(o.hi),
+        }
     }
-    if !(lo.is_finite() && hi.is_finite()) {
-        return Vec::new();
+
+    /// Whether the boxes meet.
+    pub fn overlaps(&self, o: &Self) -> bool {
+        !(self.lo.cmpgt(o.hi).any() || o.lo.cmpgt(self.hi).any())
     }
-    let cell = (0.6 * mean_edge / tri.len() as f64).max(1e-6);
-    // At most ~64 cells per triangle on average: keeps the grid small for any input.
-    let cell = cell.max(((hi - lo).element_product() / (64.0 * tri.len() as f64)).cbrt());
-    let dims = ((hi - lo) / cell).as_uvec3() + 1;
-    let key = |c: UVec3| (c.x + dims.x * (c.y + dims.y * c.z)) as usize;
-    // Truncation is the floor here (non-negative), and needs no libm call.
-    let inv = 1.0 / cell;
-    let cell_of = |p: DVec3| ((p - lo) * inv).max(DVec3::ZERO).as_uvec3().min(dims - 1);
-    let n_cells = (dims.x * dims.y * dims.z) as usize;
-    // Cell lists in one array (counting sort).
-    let mut start = vec![0u32; n_cells + 1];
-    let for_cells = |b: &(DVec3, DVec3), f: &mut dyn FnMut(usize)| {
-        let (a, c) = (cell_of(b.0), cell_of(b.1));
+}
+
+/// A uniform grid over triangle boxes (counting-sorted cell lists): which triangles may
+/// meet a given box. Built once, queried many times while the triangles stay within
+/// the boxes it was built with.
+#[derive(Debug, Clone)]
+pub struct TriangleGrid {
+    lo: Vec3,
+    inv_cell: f32,
+    dims: UVec3,
+    start: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl TriangleGrid {
+    /// A grid of `boxes` (one per triangle of `triangles` at `vertices`, which set the
+    /// cell size: about the mean edge). None when there is nothing finite to hold.
+    pub fn new(boxes: &[Aabb], triangles: &[[u32; 3]], vertices: &[Vec3]) -> Option<Self> {
+        if boxes.is_empty() {
+            return None;
+        }
+        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for b in boxes {
+            lo = lo.min(b.lo);
+            hi = hi.max(b.hi);
+        }
+        if !(lo.is_finite() && hi.is_finite()) {
+            return None;
+        }
+        let mean_edge: f64 = triangles
+            .iter()
+            .map(|t| f64::from(vertices[t[0] as usize].distance(vertices[t[1] as usize])))
+            .sum::<f64>()
+            / triangles.len().max(1) as f64;
+        let cell = (1.0 * mean_edge as f32).max(1e-6);
+        // At most ~64 cells per triangle on average: keeps the grid small for any input.
+        let cell = cell.max(((hi - lo).element_product() / (64.0 * boxes.len() as f32)).cbrt());
+        let dims = ((hi - lo) / cell).as_uvec3() + 1;
+        let n_cells = (dims.x * dims.y * dims.z) as usize;
+        let mut g = Self {
+            lo,
+            inv_cell: 1.0 / cell,
+            dims,
+            start: vec![0u32; n_cells + 1],
+            items: Vec::new(),
+        };
+        let mut start = std::mem::take(&mut g.start);
+        for b in boxes {
+            g.for_cells(b, |k| start[k + 1] += 1);
+        }
+        for k in 0..n_cells {
+            start[k + 1] += start[k];
+        }
+        let mut fill = start.clone();
+        let mut items = vec![0u32; start[n_cells] as usize];
+        for (i, b) in boxes.iter().enumerate() {
+            g.for_cells(b, |k| {
+                items[fill[k] as usize] = i as u32;
+                fill[k] += 1;
+            });
+        }
+        (g.start, g.items) = (start, items);
+        Some(g)
+    }
+
+    fn cell_of(&self, p: Vec3) -> UVec3 {
+        // Truncation is the floor here (non-negative), and needs no libm call.
+        ((p - self.lo) * self.inv_cell)
+            .max(Vec3::ZERO)
+            .as_uvec3()
+            .min(self.dims - 1)
+    }
+
+    fn key(&self, c: UVec3) -> usize {
+        (c.x + self.dims.x * (c.y + self.dims.y * c.z)) as usize
+    }
+
+    fn for_cells(&self, b: &Aabb, mut f: impl FnMut(usize)) {
+        let (a, c) = (self.cell_of(b.lo), self.cell_of(b.hi));
         for z in a.z..=c.z {
             for y in a.y..=c.y {
                 for x in a.x..=c.x {
-                    f(key(UVec3::new(x, y, z)));
+                    f(self.key(UVec3::new(x, y, z)));
                 }
             }
         }
+    }
+
+    /// The pairs `(a, b)`, `a < b`, sharing no vertex, that cross at `vertices`, among
+    /// those with at least one triangle in `query` (`queried` tells membership); `boxes`
+    /// are the triangles' current boxes, which the grid must have been built with.
+    /// Sorted.
+    pub fn crossing_pairs(
+        &self,
+        vertices: &[Vec3],
+        triangles: &[[u32; 3]],
+        boxes: &[Aabb],
+        query: &[u32],
+        queried: impl Fn(u32) -> bool + Sync,
+    ) -> Vec<(u32, u32)> {
+        // The cells the queried triangles cover, in order.
+        let mut touched = vec![false; self.start.len() - 1];
+        for &a in query {
+            self.for_cells(&boxes[a as usize], |k| touched[k] = true);
+        }
+        let cells: Vec<usize> = (0..touched.len()).filter(|&k| touched[k]).collect();
+        // Cells in parallel; the sort below makes the order independent of the split.
+        let mut pairs: Vec<(u32, u32)> = cells
+            .par_chunks(256)
+            .flat_map_iter(|chunk| {
+                let mut found = Vec::new();
+                for &k in chunk {
+                    let c = &self.items[self.start[k] as usize..self.start[k + 1] as usize];
+                    for (ia, &a) in c.iter().enumerate() {
+                        for &b in &c[ia + 1..] {
+                            if !(queried(a) || queried(b)) {
+                                continue;
+                            }
+                            let (ba, bb) = (&boxes[a as usize], &boxes[b as usize]);
+                            if !ba.overlaps(bb) {
+                                continue;
+                            }
+                            // Each pair once: in the cell holding the overlap's low corner.
+                            if self.key(self.cell_of(ba.lo.max(bb.lo))) != k {
+                                continue;
+                            }
+                            if let Some(p) = crossing(vertices, triangles, a, b) {
+                                found.push(p);
+                            }
+                        }
+                    }
+                }
+                found
+            })
+            .collect();
+        pairs.sort_unstable();
+        pairs
+    }
+}
+
+/// The pairs, as [`TriangleGrid::crossing_pairs`], for a few queried triangles: each
+/// against every triangle whose box meets its own, without a grid.
+pub fn crossing_pairs_of_few(
+    vertices: &[Vec3],
+    triangles: &[[u32; 3]],
+    boxes: &[Aabb],
+    query: &[u32],
+    queried: impl Fn(u32) -> bool,
+) -> Vec<(u32, u32)> {
+    let Some(all) = query
+        .iter()
+        .map(|&a| boxes[a as usize])
+        .reduce(|u, b| u.union(&b))
+    else {
+        return Vec::new();
     };
-    for b in &boxes {
-        for_cells(b, &mut |k| start[k + 1] += 1);
-    }
-    for k in 0..n_cells {
-        start[k + 1] += start[k];
-    }
-    let mut fill = start.clone();
-    let mut items = vec![0u32; start[n_cells] as usize];
-    for (i, b) in boxes.iter().enumerate() {
-        for_cells(b, &mut |k| {
-            items[fill[k] as usize] = i as u32;
-            fill[k] += 1;
-        });
-    }
-    let is_active = |i: u32| active.is_none_or(|a| a[ids[i as usize] as usize]);
-    let mut pairs: Vec<(u32, u32)> = Vec::new();
-    for k in 0..n_cells {
-        let c = &items[start[k] as usize..start[k + 1] as usize];
-        for (ia, &a) in c.iter().enumerate() {
-            for &b in &c[ia + 1..] {
-                if !(is_active(a) || is_active(b)) {
-                    continue;
-                }
-                let (ba, bb) = (&boxes[a as usize], &boxes[b as usize]);
-                if ba.0.cmpgt(bb.1).any() || bb.0.cmpgt(ba.1).any() {
-                    continue;
-                }
-                // Each pair once: in the cell holding the low corner of the boxes' overlap.
-                if key(cell_of(ba.0.max(bb.0))) != k {
-                    continue;
-                }
-                let (ga, gb) = (ids[a as usize], ids[b as usize]);
-                let (ta, tb) = (triangles[ga as usize], triangles[gb as usize]);
-                if ta.iter().any(|v| tb.contains(v)) {
-                    continue;
-                }
-                if triangles_cross(&tri[a as usize], &tri[b as usize]) {
-                    pairs.push(if ga < gb { (ga, gb) } else { (gb, ga) });
-                }
+    let near: Vec<u32> = (0..boxes.len() as u32)
+        .filter(|&b| boxes[b as usize].overlaps(&all))
+        .collect();
+    let mut pairs = Vec::new();
+    for &a in query {
+        for &b in &near {
+            // Each pair once: from its smaller index when both are queried.
+            if b == a || (b < a && queried(b)) || !boxes[a as usize].overlaps(&boxes[b as usize]) {
+                continue;
+            }
+            if let Some(p) = crossing(vertices, triangles, a, b) {
+                pairs.push(p);
             }
         }
     }
     pairs.sort_unstable();
     pairs
+}
+
+/// `(min, max)` if triangles `a` and `b` share no vertex and cross.
+fn crossing(vertices: &[Vec3], triangles: &[[u32; 3]], a: u32, b: u32) -> Option<(u32, u32)> {
+    let (ta, tb) = (triangles[a as usize], triangles[b as usize]);
+    if ta.iter().any(|v| tb.contains(v)) {
+        return None;
+    }
+    let (pa, pb) = (
+        ta.map(|v| vertices[v as usize]),
+        tb.map(|v| vertices[v as usize]),
+    );
+    // Most candidates lie clearly on one side of the other's plane: told apart in single
+    // precision with a margin well above its rounding; the rest get the exact test.
+    if clearly_one_side(&pa, &pb) || clearly_one_side(&pb, &pa) {
+        return None;
+    }
+    let exact = |p: [Vec3; 3]| p.map(Vec3::as_dvec3);
+    triangles_cross(&exact(pa), &exact(pb)).then_some((a.min(b), a.max(b)))
+}
+
+/// Whether all corners of `a` lie on one side of the plane of `b` by more than a margin
+/// far above single-precision rounding (about `b`'s first corner, so coordinates are
+/// small).
+fn clearly_one_side(a: &[Vec3; 3], b: &[Vec3; 3]) -> bool {
+    let (e1, e2) = (b[1] - b[0], b[2] - b[0]);
+    let n = e1.cross(e2);
+    let d = a.map(|p| n.dot(p - b[0]));
+    // |n| ~ edge², distances ~ edge³: rounding is ~1e-6 of edge³ at worst.
+    let scale = e1.length_squared().max(e2.length_squared());
+    let margin = 1e-4 * scale * scale.sqrt();
+    (d[0] > margin && d[1] > margin && d[2] > margin)
+        || (d[0] < -margin && d[1] < -margin && d[2] < -margin)
 }
 
 fn segment_hits_triangle(p: DVec3, q: DVec3, t: &[DVec3; 3]) -> bool {

@@ -16,9 +16,10 @@
 //! orientation-preserving everywhere: it is the tissue's always-valid fallback shape.
 
 use glam::{Quat, Vec3};
+use rayon::prelude::*;
 
 use crate::body::KneeAxis;
-use crate::lattice::hex_volume_points;
+use crate::lattice::{hex_volume_f32, hex_volume_points};
 
 /// Smallest Jacobian determinant the fold allows (volume may shrink to this share), up to
 /// a knee angle of about 154°; beyond, the two ramps would overlap and the back ramp
@@ -56,6 +57,46 @@ fn ramp(t: f32) -> f32 {
         1.0 - k * (1.0 - t) * (1.0 - t)
     } else {
         (t - 0.5 * EASE) / (1.0 - EASE)
+    }
+}
+
+/// A rest point in the knee's frame, with the parts of its fold weight that do not
+/// depend on the knee angle.
+#[derive(Debug, Clone, Copy, Default)]
+struct FoldPoint {
+    /// Coordinates along the axis, `up` and `front`, from the axis point.
+    along: f32,
+    z: f32,
+    y: f32,
+    /// Angle about the axis from `up` toward `front`.
+    psi: f32,
+    angular_share: f32,
+    by_height: f32,
+}
+
+impl FoldPoint {
+    fn new(f: &KneeFold, p: Vec3) -> Self {
+        let d = p - f.point;
+        let (z, y) = (d.dot(f.up), d.dot(f.front));
+        let r = (z * z + y * y).sqrt();
+        let angular_share = smoothstep(r / AXIS_RADIUS)
+            * (1.0 - smoothstep((r - FAR_START) / (FAR_END - FAR_START)));
+        Self {
+            along: d.dot(f.axis),
+            z,
+            y,
+            psi: if angular_share > 0.0 { y.atan2(z) } else { 0.0 },
+            angular_share,
+            by_height: smoothstep((HEIGHT_HALF - z) / (2.0 * HEIGHT_HALF)),
+        }
+    }
+
+    /// The point turned about the axis by the angle of `(sin, cos)`, in the rest frame.
+    fn turned(&self, f: &KneeFold, (s, c): (f32, f32)) -> Vec3 {
+        f.point
+            + f.axis * self.along
+            + f.up * (self.z * c - self.y * s)
+            + f.front * (self.z * s + self.y * c)
     }
 }
 
@@ -141,17 +182,16 @@ impl KneeFold {
 
     /// Share of the shank's rotation taken by tissue at rest position `p`.
     pub fn weight(&self, p: Vec3) -> f32 {
-        let d = p - self.point;
-        let (z, y) = (d.dot(self.up), d.dot(self.front));
-        let r = (z * z + y * y).sqrt();
-        let by_height = smoothstep((HEIGHT_HALF - z) / (2.0 * HEIGHT_HALF));
-        let angular_share = smoothstep(r / AXIS_RADIUS)
-            * (1.0 - smoothstep((r - FAR_START) / (FAR_END - FAR_START)));
-        if angular_share <= 0.0 {
-            return by_height;
+        self.weight_of(&FoldPoint::new(self, p))
+    }
+
+    /// [`Self::weight`] of a point whose angle-free parts are known.
+    fn weight_of(&self, f: &FoldPoint) -> f32 {
+        if f.angular_share <= 0.0 {
+            return f.by_height;
         }
-        let by_angle = self.angular(y.atan2(z));
-        angular_share * by_angle + (1.0 - angular_share) * by_height
+        let by_angle = self.angular(f.psi);
+        f.angular_share * by_angle + (1.0 - f.angular_share) * f.by_height
     }
 
     /// The rotation tissue at rest position `p` takes.
@@ -191,25 +231,109 @@ impl KneeFold {
 /// Rounds of repair for elements the fold turns over (see [`fold_hexes`]).
 const SMOOTHING_ROUNDS: usize = 6;
 
-/// A hexahedral lattice's rest shape `rest` carried by the fold (thigh rest frame). The
-/// map is orientation-preserving, but a skewed hexahedron much larger than the scale on
-/// which the weight varies (one reaching from near the axis to the back of the knee)
-/// can still turn over between its corners. Such an element moves its corners' weights
-/// toward their mean (which turns it rigidly), by the largest step that improves it and
-/// turns no positive neighbour over, round after round. Returns the positions and each
-/// vertex's weight.
-pub fn fold_hexes(fold: &KneeFold, rest: &[Vec3], hexes: &[[u32; 8]]) -> (Vec<Vec3>, Vec<f32>) {
-    let mut w: Vec<f32> = rest.iter().map(|&p| fold.weight(p)).collect();
-    let place = |p: Vec3, w: f32| {
-        fold.point + Quat::from_axis_angle(fold.axis, fold.theta * w) * (p - fold.point)
-    };
-    let mut x: Vec<Vec3> = rest.iter().zip(&w).map(|(&p, &w)| place(p, w)).collect();
+/// Where the fold can bend tissue: within [`FAR_END`] of the knee axis or within
+/// [`HEIGHT_HALF`] of its level. Elsewhere the weight is exactly 0 (thigh) or 1 (shank)
+/// at every knee angle, so that tissue moves rigidly with its bone and needs no
+/// trigonometry and no check.
+#[derive(Debug, Clone)]
+pub struct FoldZone {
+    /// Per vertex: [`ZONE`], or its fixed weight 0 or 1.
+    kind: Vec<u8>,
+    /// Per vertex, its place in the knee's frame and the angle-free parts of its weight.
+    points: Vec<FoldPoint>,
+    /// Elements with a corner in the zone.
+    elements: Vec<u32>,
+}
+
+const THIGH: u8 = 0;
+const SHANK: u8 = 1;
+const ZONE: u8 = 2;
+
+impl FoldZone {
+    /// The zone of a knee for a lattice at rest.
+    pub fn new(knee: &KneeAxis, rest: &[Vec3], hexes: &[[u32; 8]]) -> Self {
+        let f = KneeFold::new(knee, 0.0);
+        let points: Vec<FoldPoint> = rest.iter().map(|&p| FoldPoint::new(&f, p)).collect();
+        let kind: Vec<u8> = points
+            .iter()
+            .map(|fp| {
+                let (z, y) = (fp.z, fp.y);
+                if (z * z + y * y).sqrt() < FAR_END || z.abs() < HEIGHT_HALF {
+                    ZONE
+                } else if z >= HEIGHT_HALF {
+                    THIGH
+                } else {
+                    SHANK
+                }
+            })
+            .collect();
+        let elements = (0..hexes.len() as u32)
+            .filter(|&e| hexes[e as usize].iter().any(|&v| kind[v as usize] == ZONE))
+            .collect();
+        Self {
+            kind,
+            points,
+            elements,
+        }
+    }
+
+    /// Whether vertex `v` can bend (else it moves rigidly with its bone).
+    pub fn contains(&self, v: usize) -> bool {
+        self.kind[v] == ZONE
+    }
+
+    /// Elements with a corner in the zone (the others move rigidly).
+    pub fn elements(&self) -> &[u32] {
+        &self.elements
+    }
+}
+
+/// A hexahedral lattice's rest shape `rest` carried by the fold and then by `frame` (the
+/// thigh's pose), into `x`, with each vertex's weight into `w`. The map is
+/// orientation-preserving, but a skewed hexahedron much larger than the scale on which
+/// the weight varies (one reaching from near the axis to the back of the knee) can still
+/// turn over between its corners. Such an element moves its corners' weights toward their
+/// mean (which turns it rigidly), by the largest step that improves it and turns no
+/// positive neighbour over, round after round.
+pub fn fold_hexes(
+    fold: &KneeFold,
+    zone: &FoldZone,
+    rest: &[Vec3],
+    hexes: &[[u32; 8]],
+    (tq, tt): (Quat, Vec3),
+    x: &mut Vec<Vec3>,
+    w: &mut Vec<f32>,
+) {
+    let shank = Quat::from_axis_angle(fold.axis, fold.theta);
+    let frame = glam::Mat3::from_quat(tq);
+    let place =
+        |i: usize, w: f32| frame * zone.points[i].turned(fold, (fold.theta * w).sin_cos()) + tt;
+    x.resize(rest.len(), Vec3::ZERO);
+    w.resize(rest.len(), 0.0);
+    x.par_iter_mut()
+        .zip(w.par_iter_mut())
+        .enumerate()
+        .for_each(|(i, (xi, wi))| {
+            let p = rest[i];
+            (*wi, *xi) = match zone.kind[i] {
+                THIGH => (0.0, frame * p + tt),
+                SHANK => (1.0, frame * (fold.point + shank * (p - fold.point)) + tt),
+                _ => {
+                    let wt = fold.weight_of(&zone.points[i]);
+                    (wt, place(i, wt))
+                }
+            };
+        });
     let volume = |x: &[Vec3], h: &[u32; 8]| hex_volume_points(&h.map(|i| x[i as usize].as_dvec3()));
-    let mut turned: Vec<usize> = (0..hexes.len())
-        .filter(|&e| volume(&x, &hexes[e]) <= 0.0)
+    // Screened in single precision; anything near flat is looked at again in double.
+    let mut turned: Vec<usize> = zone
+        .elements
+        .par_iter()
+        .map(|&e| e as usize)
+        .filter(|&e| hex_volume_f32(x, &hexes[e]) <= 1e-12 && volume(x, &hexes[e]) <= 0.0)
         .collect();
     if turned.is_empty() {
-        return (x, w);
+        return;
     }
     // Vertex → elements, only when something needs fixing (rare).
     let mut of_vertex: Vec<Vec<u32>> = vec![Vec::new(); rest.len()];
@@ -222,7 +346,7 @@ pub fn fold_hexes(fold: &KneeFold, rest: &[Vec3], hexes: &[[u32; 8]]) -> (Vec<Ve
         let mut changed = false;
         for &e in &turned {
             let h = hexes[e];
-            let own = volume(&x, &h);
+            let own = volume(x, &h);
             if own > 0.0 {
                 continue;
             }
@@ -234,7 +358,7 @@ pub fn fold_hexes(fold: &KneeFold, rest: &[Vec3], hexes: &[[u32; 8]]) -> (Vec<Ve
             touching.dedup();
             let before_vol: Vec<f64> = touching
                 .iter()
-                .map(|&o| volume(&x, &hexes[o as usize]))
+                .map(|&o| volume(x, &hexes[o as usize]))
                 .collect();
             let mean = h.iter().map(|&i| w[i as usize]).sum::<f32>() / 8.0;
             let before = h.map(|i| (w[i as usize], x[i as usize]));
@@ -242,14 +366,14 @@ pub fn fold_hexes(fold: &KneeFold, rest: &[Vec3], hexes: &[[u32; 8]]) -> (Vec<Ve
                 for (k, &i) in h.iter().enumerate() {
                     let wi = before[k].0 + t * (mean - before[k].0);
                     w[i as usize] = wi;
-                    x[i as usize] = place(rest[i as usize], wi);
+                    x[i as usize] = place(i as usize, wi);
                 }
                 // Accepted if this element improves and no positive neighbour turns over.
-                let ok = volume(&x, &h) > own
+                let ok = volume(x, &h) > own
                     && touching
                         .iter()
                         .zip(&before_vol)
-                        .all(|(&o, &v0)| v0 <= 0.0 || volume(&x, &hexes[o as usize]) > 0.0);
+                        .all(|(&o, &v0)| v0 <= 0.0 || volume(x, &hexes[o as usize]) > 0.0);
                 if ok {
                     changed = true;
                     break;
@@ -259,12 +383,11 @@ pub fn fold_hexes(fold: &KneeFold, rest: &[Vec3], hexes: &[[u32; 8]]) -> (Vec<Ve
                 }
             }
         }
-        turned.retain(|&e| volume(&x, &hexes[e]) <= 0.0);
+        turned.retain(|&e| volume(x, &hexes[e]) <= 0.0);
         if !changed || turned.is_empty() {
             break;
         }
     }
-    (x, w)
 }
 
 /// Contact behind the knee: the plane through the knee axis that bisects the knee angle.
@@ -345,6 +468,33 @@ mod tests {
                 worst > 0.5 * MIN_JACOBIAN,
                 "at {deg}°, Jacobian determinant {worst}"
             );
+        }
+    }
+
+    #[test]
+    fn outside_the_zone_the_weight_is_fixed_at_every_angle() {
+        let k = knee();
+        let pts: Vec<Vec3> = (-40..=40)
+            .flat_map(|iz| {
+                (-6..=6)
+                    .map(move |iy| k.point + Vec3::new(0.01, iy as f32 * 0.02, iz as f32 * 0.01))
+            })
+            .collect();
+        let zone = FoldZone::new(&k, &pts, &[]);
+        let outside = (0..pts.len()).filter(|&i| !zone.contains(i)).count();
+        assert!(
+            outside > pts.len() / 4,
+            "{outside} of {} outside",
+            pts.len()
+        );
+        for deg in [-20.0f32, 0.0, 45.0, 100.0, 140.0] {
+            let f = KneeFold::new(&k, deg.to_radians());
+            for (i, &p) in pts.iter().enumerate() {
+                if !zone.contains(i) {
+                    let fixed = if zone.kind[i] == SHANK { 1.0 } else { 0.0 };
+                    assert_eq!(f.weight(p), fixed, "{p} at {deg}°");
+                }
+            }
         }
     }
 

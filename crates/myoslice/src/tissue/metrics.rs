@@ -6,7 +6,7 @@ use super::Tissue;
 use rayon::prelude::*;
 
 use super::polar::{covariance, polar_rotation_exact, rotation_step};
-use crate::lattice::{Lattice, hex_volume_points, quad_area};
+use crate::lattice::{hex_volume_f32, quad_area};
 
 /// Metrics of the tissue at one moment; arrays are contiguous, one value per fat
 /// hexahedron (lattice order) or per muscle (simulation order).
@@ -35,36 +35,31 @@ pub struct TissueMetrics {
 
 impl TissueMetrics {
     /// Measures the tissue now, every element.
-    pub fn measure(lattice: &Lattice, t: &Tissue) -> Self {
-        Self::measure_where(lattice, t, None)
+    pub fn measure(t: &Tissue) -> Self {
+        Self::measure_where(t, None)
     }
 
     /// Measures the elements the last update relaxed ([`super::FatSolver::active`]); the
     /// others moved rigidly with a bone, so they have no deformation, no area change and
     /// their rest volume.
-    pub fn measure_active(lattice: &Lattice, t: &Tissue) -> Self {
-        Self::measure_where(lattice, t, Some(&t.fat.active))
+    pub fn measure_active(t: &Tissue) -> Self {
+        Self::measure_where(t, Some(&t.fat.active))
     }
 
-    fn measure_where(lattice: &Lattice, t: &Tissue, only: Option<&[bool]>) -> Self {
+    fn measure_where(t: &Tissue, only: Option<&[bool]>) -> Self {
         let fat = &t.fat;
         let n = fat.hexes.len();
-        let mut skip = vec![false; n];
-        if let Some(only) = only {
-            for (s, a) in skip.iter_mut().zip(only) {
-                *s = !a;
-            }
-        }
+        let measured = |e: usize| only.is_none_or(|a| a[e]);
         // Volume ratio and deformation degree per element, in parallel.
         let per: Vec<(f32, f32)> = (0..n)
             .into_par_iter()
             .map(|e| {
-                if skip[e] {
+                if !measured(e) {
                     return (1.0, 0.0);
                 }
                 let h = fat.hexes[e];
                 let p = h.map(|i| fat.x[i as usize]);
-                let v = hex_volume_points(&p.map(Vec3::as_dvec3));
+                let v = f64::from(hex_volume_f32(&fat.x, &h));
                 let c = p.iter().copied().sum::<Vec3>() / 8.0;
                 let d = p.map(|q| q - c);
                 let r = fat.rest_relative(e);
@@ -86,20 +81,15 @@ impl TissueMetrics {
         let degree: Vec<f32> = per.iter().map(|p| p.1).collect();
         let inverted = volume_ratio.iter().filter(|&&r| r <= 0.0).count();
         let mut area_change = vec![0.0f32; n];
-        for (h, quad) in lattice.fat.outer_faces() {
-            if skip[h as usize] {
-                continue;
-            }
-            let a0 = quad_area(&fat.rest, &quad);
-            let a = quad_area(&fat.x, &quad);
-            if a0 > 0.0 {
-                area_change[h as usize] = (a / a0 - 1.0) as f32;
+        for &(h, quad, a0) in t.outer_faces() {
+            if measured(h as usize) && a0 > 0.0 {
+                area_change[h as usize] = (quad_area(&fat.x, &quad) / a0 - 1.0) as f32;
             }
         }
         let muscle_volume_ratio: Vec<f32> = t
             .muscles
             .iter()
-            .map(|m| (m.volume() / m.rest_volume.max(1e-12)) as f32)
+            .map(|m| (m.volume_now / m.rest_volume.max(1e-12)) as f32)
             .collect();
         Self {
             min_volume_ratio: volume_ratio.iter().copied().fold(f32::INFINITY, f32::min),

@@ -2,8 +2,10 @@
 //! that follows muscles and bones, the knee fold and contact plane behind the knee, a
 //! validity guard, and the per-element metrics of the paper (section 5.3).
 
+mod bone_slide;
 mod fat_lanes;
 pub mod fat_solver;
+mod guard;
 pub mod intersect;
 pub mod knee_fold;
 pub mod metrics;
@@ -12,20 +14,22 @@ pub mod polar;
 
 use std::sync::Arc;
 
-use glam::Vec3;
-use parry3d::query::PointQuery;
+use glam::{Quat, Vec3};
 use parry3d::shape::TriMesh;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 pub use fat_solver::FatSolver;
-pub use knee_fold::{Contact, KneeFold};
+pub use knee_fold::{Contact, FoldZone, KneeFold};
 pub use metrics::TissueMetrics;
 pub use muscle_shape::MuscleShape;
 
 use crate::body::{BodyId, KneeAxis, body_of_bone};
 use crate::error::{Result, check_range};
-use crate::lattice::{InnerContact, Lattice, hex_volume_points};
+use crate::lattice::{InnerContact, Lattice};
 use crate::muscle::{BodyFrames, MuscleUnit};
+use bone_slide::{BoneMesh, BoneSlide};
+use guard::Guard;
 
 /// Tissue options (all with documented defaults).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -84,6 +88,9 @@ impl TissueConfig {
     }
 }
 
+/// Share of a muscle surface's sliding (along the fat layer) that drags the fat over it.
+const FASCIA_DRAG: f32 = 0.2;
+
 /// Extra distance (m) from the contact plane per fat layer below the skin.
 const LAYER_GAP: f32 = 0.001;
 
@@ -91,19 +98,46 @@ const LAYER_GAP: f32 = 0.001;
 /// guarded against crossing; farther out the tissue moves nearly rigidly with its bone.
 const GUARD_RADIUS: f32 = 0.25;
 
-/// Times the validity guard halves an offending vertex's relaxation before it puts the
-/// vertex on the fold outright.
-const GUARD_HALVINGS: u8 = 2;
-
 /// Squared distance (m²) from the fold below which a fat vertex counts as moving
 /// rigidly with its bone.
 const RIGID_TOLERANCE_M2: f32 = 1e-12;
 
-/// Most rounds of the validity guard (each settles at least one more vertex).
-const GUARD_MAX_ROUNDS: usize = 64;
-
 /// Bone surfaces for tissue queries: body and mesh (rest frame) of each lattice bone.
 pub type BoneSurfaces = Arc<Vec<(BodyId, TriMesh)>>;
+
+/// What a tissue update needs that never changes: built once from the lattice.
+#[derive(Debug)]
+struct TissueStatic {
+    /// Fat vertex → (muscle, muscle vertex) it follows.
+    muscle_ref: Vec<Option<(u32, u32)>>,
+    /// Whether a fat vertex belongs to the thigh side of the knee.
+    thigh_side: Vec<bool>,
+    /// Fat vertices behind the knee axis at rest (the contact acts there).
+    posterior: Vec<u32>,
+    /// Body-surface triangles near the knee, checked for crossings after each update.
+    guard_triangles: Vec<[u32; 3]>,
+    /// Where the knee fold can bend the fat.
+    zone: FoldZone,
+    /// Bone surfaces with adjacency, lattice bone order.
+    bone_meshes: Vec<BoneMesh>,
+    /// Outer (skin) face of each outer-layer element and its rest area (m²).
+    outer_faces: Vec<(u32, [u32; 4], f64)>,
+}
+
+/// Buffers an update fills anew each time, kept to avoid allocating them.
+#[derive(Debug, Clone, Default)]
+struct Scratch {
+    /// The knee fold of the rest shape (world): valid, the guard's fallback.
+    safe: Vec<Vec3>,
+    /// Fold weight of each vertex.
+    weights: Vec<f32>,
+    /// The first guess of the update.
+    guess: Vec<Vec3>,
+    moving: Vec<bool>,
+    /// Where each inner vertex facing a muscle is pulled this update.
+    muscle_targets: Vec<(u32, Vec3)>,
+    guard: Guard,
+}
 
 /// The deformable tissue of a simulation.
 #[derive(Debug, Clone)]
@@ -113,24 +147,15 @@ pub struct Tissue {
     pub muscles: Vec<MuscleShape>,
     /// The fat solver.
     pub fat: FatSolver,
-    /// Fat vertex → (muscle, muscle vertex) it follows.
-    muscle_ref: Vec<Option<(u32, u32)>>,
-    /// Fat vertex → (bone, rest distance from its surface) it slides on.
-    bone_ref: Vec<Option<(u32, f32)>>,
-    /// Fat vertex side of the knee: +1 thigh, −1 shank.
-    side: Vec<f32>,
-    /// Whether a fat vertex lies behind the knee axis at rest (the contact acts there).
-    posterior: Vec<bool>,
-    /// Body-surface triangles near the knee, checked for crossings after each update.
-    guard_triangles: Vec<[u32; 3]>,
-    /// Where each inner vertex facing a muscle is pulled this update (scratch).
-    muscle_targets: Vec<(u32, Vec3)>,
+    fixed: Arc<TissueStatic>,
+    /// Fat vertices that slide on bone, with the triangle each last touched.
+    bone_slide: BoneSlide,
     /// Motion of the last update beyond the skinned guess (for momentum).
     drift: Vec<Vec3>,
+    scratch: Scratch,
     knee: KneeAxis,
     theta: f32,
     layers: usize,
-    bones: BoneSurfaces,
     /// Metrics at the last update.
     pub metrics: TissueMetrics,
     /// Time accumulated since the last update (s).
@@ -155,10 +180,10 @@ impl Tissue {
         let solver = FatSolver::new(&fat.vertices, &fat.hexes);
         let nv = fat.vertices.len();
         let mut muscle_ref = vec![None; nv];
-        let mut bone_ref = vec![None; nv];
+        let mut on_bone = Vec::new();
         for (k, c) in fat.inner_contact.iter().enumerate() {
             let (s, j) = (k / fat.rays, k % fat.rays);
-            let v = fat.vertex_index(s, j, 0) as usize;
+            let v = fat.vertex_index(s, j, 0);
             match *c {
                 InnerContact::Muscle(_) => {
                     if let Some((mi, mv)) = lattice.fat_muscle_ref[k] {
@@ -166,28 +191,20 @@ impl Tissue {
                         if let Some(si) =
                             muscles.iter().position(|m| m.lattice_index == mi as usize)
                         {
-                            muscle_ref[v] = Some((si as u32, mv));
+                            muscle_ref[v as usize] = Some((si as u32, mv));
                         }
                     }
                 }
                 InnerContact::Bone(label) => {
                     if let Some(bi) = lattice.bones.iter().position(|b| b.label == label) {
-                        let p = fat.vertices[v];
-                        let d = bones[bi].1.project_local_point(p, false).point.distance(p);
-                        bone_ref[v] = Some((bi as u32, d));
+                        on_bone.push((v, bi as u32));
                     }
                 }
                 InnerContact::Free => {}
             }
         }
         let kz = knee.point.z;
-        let side = fat
-            .vertices
-            .iter()
-            .map(|p| if p.z >= kz { 1.0 } else { -1.0 })
-            .collect();
         let fold = KneeFold::new(&knee, 0.0);
-        let posterior = fat.vertices.iter().map(|&p| fold.is_posterior(p)).collect();
         // Behind the knee, where the thigh and calf press on each other; in front the
         // skin only stretches.
         let guard_triangles = fat
@@ -200,25 +217,37 @@ impl Tissue {
                 })
             })
             .collect();
+        let outer_faces = fat
+            .outer_faces()
+            .into_iter()
+            .map(|(h, q)| (h, q, crate::lattice::quad_area(&fat.vertices, &q)))
+            .collect();
+        let fixed = TissueStatic {
+            muscle_ref,
+            thigh_side: fat.vertices.iter().map(|p| p.z >= kz).collect(),
+            posterior: (0..nv as u32)
+                .filter(|&v| fold.is_posterior(fat.vertices[v as usize]))
+                .collect(),
+            guard_triangles,
+            zone: FoldZone::new(&knee, &fat.vertices, &fat.hexes),
+            bone_meshes: bones.iter().map(|(b, m)| BoneMesh::new(*b, m)).collect(),
+            outer_faces,
+        };
         let mut tissue = Self {
             config,
             muscles: shapes,
             drift: vec![Vec3::ZERO; nv],
             fat: solver,
-            muscle_ref,
-            bone_ref,
-            side,
-            posterior,
-            guard_triangles,
-            muscle_targets: Vec::new(),
+            bone_slide: BoneSlide::new(&on_bone, &fat.vertices, &bones),
+            fixed: Arc::new(fixed),
+            scratch: Scratch::default(),
             knee,
             theta: 0.0,
             layers: fat.layers,
-            bones,
             metrics: TissueMetrics::default(),
             pending: 0.0,
         };
-        tissue.metrics = TissueMetrics::measure(lattice, &tissue);
+        tissue.metrics = TissueMetrics::measure(&tissue);
         Ok(tissue)
     }
 
@@ -232,15 +261,14 @@ impl Tissue {
         1.0 / self.config.rate_hz
     }
 
+    /// Outer (skin) face of each outer-layer element, with its rest area (m²).
+    pub fn outer_faces(&self) -> &[(u32, [u32; 4], f64)] {
+        &self.fixed.outer_faces
+    }
+
     /// Deforms muscles and fat for the current skeleton and chains. Returns false (and
     /// keeps the previous shape) if anything became non-finite.
-    pub fn update(
-        &mut self,
-        lattice: &Lattice,
-        knee_angle: f64,
-        frames: &BodyFrames,
-        muscles: &[MuscleUnit],
-    ) -> bool {
+    pub fn update(&mut self, knee_angle: f64, frames: &BodyFrames, muscles: &[MuscleUnit]) -> bool {
         // Everything an update changes, to put back if it fails.
         let backup = (
             self.fat.x.clone(),
@@ -250,12 +278,13 @@ impl Tissue {
             self.drift.clone(),
             self.theta,
             self.metrics.clone(),
+            self.bone_slide.clone(),
             self.muscles
                 .iter()
-                .map(|m| m.current.clone())
+                .map(|m| (m.current.clone(), m.volume_now))
                 .collect::<Vec<_>>(),
         );
-        self.deform(lattice, knee_angle, frames, muscles);
+        self.deform(knee_angle, frames, muscles);
         let ok = self.fat.x.iter().all(|p| p.is_finite())
             && self.drift.iter().all(|p| p.is_finite())
             && self
@@ -263,23 +292,18 @@ impl Tissue {
                 .iter()
                 .all(|m| m.current.iter().all(|p| p.is_finite()));
         if !ok {
-            let (x, rot, free, active, drift, theta, metrics, current) = backup;
+            let (x, rot, free, active, drift, theta, metrics, slide, current) = backup;
             (self.fat.x, self.fat.rot, self.fat.free, self.fat.active) = (x, rot, free, active);
             (self.drift, self.theta, self.metrics) = (drift, theta, metrics);
-            for (shape, c) in self.muscles.iter_mut().zip(current) {
-                shape.current = c;
+            self.bone_slide = slide;
+            for (shape, (c, v)) in self.muscles.iter_mut().zip(current) {
+                (shape.current, shape.volume_now) = (c, v);
             }
         }
         ok
     }
 
-    fn deform(
-        &mut self,
-        lattice: &Lattice,
-        knee_angle: f64,
-        frames: &BodyFrames,
-        muscles: &[MuscleUnit],
-    ) {
+    fn deform(&mut self, knee_angle: f64, frames: &BodyFrames, muscles: &[MuscleUnit]) {
         let theta = knee_angle as f32;
         let fold = KneeFold::new(&self.knee, theta);
         let (tq, tt) = frames.thigh;
@@ -295,104 +319,147 @@ impl Tissue {
         };
         // Muscles are not pushed by the contact plane: their volume is the invariant
         // kept; the fat over them is.
-        for (shape, m) in self.muscles.iter_mut().zip(muscles) {
-            // A muscle resting on one body keeps its rest shape and moves with the body.
-            let quiet = !m.crosses_knee && m.activation < 1e-4 && m.excitation == 0.0;
-            match m.chain.single_body() {
-                Some(b) if quiet => {
-                    let (q, t) = match b {
-                        BodyId::Thigh => frames.thigh,
-                        BodyId::Shank => frames.shank,
-                    };
-                    shape.carry(q, t);
+        self.muscles
+            .par_iter_mut()
+            .zip(muscles)
+            .for_each(|(shape, m)| {
+                // A muscle resting on one body keeps its rest shape and moves with it.
+                let quiet = !m.crosses_knee && m.activation < 1e-4 && m.excitation == 0.0;
+                match m.chain.single_body() {
+                    Some(b) if quiet => {
+                        let (q, t) = match b {
+                            BodyId::Thigh => frames.thigh,
+                            BodyId::Shank => frames.shank,
+                        };
+                        shape.carry(q, t);
+                    }
+                    _ => shape.update(&m.chain, &fold, None),
                 }
-                _ => shape.update(&m.chain, &fold, None),
-            }
-        }
+            });
+        let fixed = Arc::clone(&self.fixed);
+        let mut sc = std::mem::take(&mut self.scratch);
         // The fold of the rest shape is valid: the fallback of the guard below.
-        let (folded, weights) = knee_fold::fold_hexes(&fold, &self.fat.rest, &self.fat.hexes);
-        let safe: Vec<Vec3> = folded.into_iter().map(|p| tq * p + tt).collect();
+        knee_fold::fold_hexes(
+            &fold,
+            &fixed.zone,
+            &self.fat.rest,
+            &self.fat.hexes,
+            (tq, tt),
+            &mut sc.safe,
+            &mut sc.weights,
+        );
+        let (safe, weights) = (&sc.safe, &sc.weights);
         // Where each inner vertex facing a muscle goes: with its reference muscle vertex,
         // keeping its rest offset from it turned as the tissue about it turns (the
         // paper's moving vector alone would shear thin fat at large angles).
-        self.muscle_targets.clear();
-        for (v, r) in self.muscle_ref.iter().enumerate() {
+        sc.muscle_targets.clear();
+        for (v, r) in fixed.muscle_ref.iter().enumerate() {
             let Some((m, mv)) = *r else { continue };
             let shape = &self.muscles[m as usize];
-            let turn = tq * glam::Quat::from_axis_angle(fold.axis, theta * weights[v]);
+            let turn = tq * Quat::from_axis_angle(fold.axis, theta * weights[v]);
             let offset = self.fat.rest[v] - shape.rest[mv as usize];
-            self.muscle_targets
-                .push((v as u32, shape.current[mv as usize] + turn * offset));
+            let follow = shape.current[mv as usize] + turn * offset;
+            // Across the layer the fat follows the muscle fully (a bulge pushes the skin
+            // out); along it the muscle glides under its fascia and drags the fat only
+            // partly (following its sliding fully shears the elements inside out).
+            let (base, outer) = (safe[v], safe[v + self.layers]);
+            let n = (outer - base).normalize_or_zero();
+            let d = follow - base;
+            let across = n * d.dot(n);
+            sc.muscle_targets
+                .push((v as u32, base + across + (d - across) * FASCIA_DRAG));
         }
         // First guess, from the fold (so nothing accumulates): each radial column of
-        // vertices moves with its inner vertex where that follows a muscle, the skin by
-        // half as much; part of the last update's correction is carried over (inertia
-        // with damping).
+        // vertices moves with its inner vertex where that follows a muscle (across the
+        // layer as a whole, along it the skin by half as much); part of the last
+        // update's correction is carried over (inertia with damping).
         let momentum = self.config.momentum as f32;
-        let lat = &lattice.fat;
-        let mut guess = safe.clone();
-        let l1 = lat.layers + 1;
-        for &(inner, target) in &self.muscle_targets {
+        let layers = self.layers;
+        sc.guess.clone_from(safe);
+        for &(inner, target) in &sc.muscle_targets {
             // Inner vertices are layer 0 of their column (see `FatLattice::vertex_index`).
             let inner = inner as usize;
-            let delta = target - guess[inner];
-            for (l, g) in guess[inner..inner + l1].iter_mut().enumerate() {
-                *g += delta * (1.0 - 0.5 * l as f32 / lat.layers as f32);
+            let delta = target - sc.guess[inner];
+            let n = (sc.guess[inner + layers] - sc.guess[inner]).normalize_or_zero();
+            let normal = n * delta.dot(n);
+            let along = delta - normal;
+            for (l, g) in sc.guess[inner..=inner + layers].iter_mut().enumerate() {
+                *g += normal + along * (1.0 - 0.5 * l as f32 / layers as f32);
             }
         }
-        for (i, p) in self.fat.x.iter_mut().enumerate() {
-            *p = guess[i] + self.drift[i] * momentum;
-        }
+        let guess = &sc.guess;
+        self.fat
+            .x
+            .par_iter_mut()
+            .zip(guess.par_iter().zip(&self.drift))
+            .for_each(|(x, (g, d))| *x = *g + *d * momentum);
         // Relax only where the fat does not simply move with a bone.
-        let mut moving: Vec<bool> = (0..safe.len())
-            .map(|i| {
-                (weights[i] > 0.0 && weights[i] < 1.0)
-                    || self.fat.x[i].distance_squared(safe[i]) > RIGID_TOLERANCE_M2
-            })
-            .collect();
-        for h in &self.fat.hexes {
+        sc.moving.clear();
+        sc.moving.extend((0..safe.len()).map(|i| {
+            (weights[i] > 0.0 && weights[i] < 1.0)
+                || self.fat.x[i].distance_squared(safe[i]) > RIGID_TOLERANCE_M2
+        }));
+        for &e in fixed.zone.elements() {
+            let h = &self.fat.hexes[e as usize];
             let w0 = weights[h[0] as usize];
             if h.iter().any(|&v| weights[v as usize] != w0) {
                 for &v in h {
-                    moving[v as usize] = true;
+                    sc.moving[v as usize] = true;
                 }
             }
         }
-        self.fat.restrict_to(&moving);
+        self.fat.restrict_to(&sc.moving);
         // Elements left out turn with their bone: keep their warm start on that rotation,
         // so that one becoming active later starts from its true orientation.
+        let shank_turn = tq * Quat::from_axis_angle(fold.axis, theta);
         for (e, h) in self.fat.hexes.iter().enumerate() {
             if !self.fat.active[e] {
                 let w = weights[h[0] as usize];
-                self.fat.rot[e] = tq * glam::Quat::from_axis_angle(fold.axis, theta * w);
+                self.fat.rot[e] = match w {
+                    0.0 => tq,
+                    1.0 => shank_turn,
+                    _ => tq * Quat::from_axis_angle(fold.axis, theta * w),
+                };
             }
         }
-        self.apply_muscles();
+        let targets = &sc.muscle_targets;
+        self.apply_muscles(targets);
         self.apply_contact(&contact, gap);
         let k = self.config.stiffness as f32;
         for _ in 0..self.config.iterations {
             self.fat.iterate(k);
-            self.apply_muscles();
+            self.apply_muscles(targets);
             self.apply_contact(&contact, gap);
         }
-        self.apply_bones(frames);
+        let pose = |b: BodyId| match b {
+            BodyId::Thigh => frames.thigh,
+            BodyId::Shank => frames.shank,
+        };
+        self.bone_slide
+            .apply(&mut self.fat.x, &self.fat.free, &fixed.bone_meshes, pose);
         self.apply_contact(&contact, gap);
-        let guarded = self.guard(&safe);
+        let guarded = sc.guard.run(
+            &mut self.fat,
+            safe,
+            &fixed.guard_triangles,
+            self.config.min_volume_ratio as f32,
+            self.config.surface_guard,
+        );
         for i in 0..self.drift.len() {
             self.drift[i] = self.fat.x[i] - guess[i];
         }
         self.theta = theta;
-        self.metrics = TissueMetrics::measure_active(lattice, self);
+        self.scratch = sc;
+        self.metrics = TissueMetrics::measure_active(self);
         self.metrics.guarded_vertices = guarded;
     }
 
-    /// Pulls inner vertices facing a muscle toward their reference muscle vertex's moving
-    /// vector (the paper's rule), strongly but not rigidly, so that millimetre noise of
-    /// the muscle surface cannot fold the thin fat elements; shape matching shares the
-    /// rest.
-    fn apply_muscles(&mut self) {
+    /// Pulls inner vertices facing a muscle toward their targets (the paper's rule, see
+    /// [`FASCIA_DRAG`]), strongly but not rigidly, so that millimetre noise of the muscle
+    /// surface cannot fold the thin fat elements; shape matching shares the rest.
+    fn apply_muscles(&mut self, targets: &[(u32, Vec3)]) {
         const PULL: f32 = 0.7;
-        for &(v, target) in &self.muscle_targets {
+        for &(v, target) in targets {
             let cur = self.fat.x[v as usize];
             self.fat.x[v as usize] = cur + (target - cur) * PULL;
         }
@@ -401,174 +468,21 @@ impl Tissue {
     /// Keeps thigh-side and calf-side fat apart behind the knee ([`Contact`]).
     fn apply_contact(&mut self, c: &Contact, gap: f32) {
         let l1 = self.layers + 1;
-        for (v, (p, &s)) in self.fat.x.iter_mut().zip(&self.side).enumerate() {
+        for &v in &self.fixed.posterior {
+            let v = v as usize;
             // Vertices outside the relaxed region sit on the fold, which keeps its side.
-            if !self.posterior[v] || !self.fat.free[v] {
+            if !self.fat.free[v] {
                 continue;
             }
             // Deeper layers stop further from the contact, so squeezed elements stay
             // thin but never flat.
             let depth = (self.layers - v % l1) as f32;
-            *p = c.apply(*p, s > 0.0, gap + LAYER_GAP * depth);
+            self.fat.x[v] = c.apply(
+                self.fat.x[v],
+                self.fixed.thigh_side[v],
+                gap + LAYER_GAP * depth,
+            );
         }
-    }
-
-    fn apply_bones(&mut self, frames: &BodyFrames) {
-        for (v, r) in self.bone_ref.iter().enumerate() {
-            let Some((b, d0)) = *r else { continue };
-            if !self.fat.free[v] {
-                continue; // moves rigidly with its bone already
-            }
-            let (body, mesh) = &self.bones[b as usize];
-            let (q, t) = match body {
-                BodyId::Thigh => frames.thigh,
-                BodyId::Shank => frames.shank,
-            };
-            let p_rest = q.inverse() * (self.fat.x[v] - t);
-            let proj = mesh.project_local_point(p_rest, false);
-            let out = if proj.is_inside {
-                (proj.point - p_rest).normalize_or_zero()
-            } else {
-                (p_rest - proj.point).normalize_or_zero()
-            };
-            // Slide on the bone: pulled onto the surface (at its rest distance), softly.
-            let target = q * (proj.point + out * d0) + t;
-            let cur = self.fat.x[v];
-            self.fat.x[v] = cur + (target - cur) * if proj.is_inside { 1.0 } else { 0.7 };
-        }
-    }
-
-    /// The validity guard (beyond the paper, which reports fat that breaks): where the
-    /// relaxed shape has an element below its allowed volume or body-surface triangles
-    /// behind the knee that cross, the vertices involved give back half of their way from
-    /// the fold (`safe`) to the relaxed shape, round after round, and after
-    /// [`GUARD_HALVINGS`] halvings take the fold outright; the vertices around them give
-    /// back part of the way too. Elsewhere the relaxed shape stands. After the first round only what the last round moved is looked at again.
-    /// Returns how many vertices it moved off the relaxed shape.
-    fn guard(&mut self, safe: &[Vec3]) -> usize {
-        let eps = self.config.min_volume_ratio;
-        let n_el = self.fat.hexes.len();
-        let volume = |x: &[Vec3], e: usize, hexes: &[[u32; 8]]| {
-            hex_volume_points(&hexes[e].map(|i| x[i as usize].as_dvec3()))
-        };
-        let floor = |e: usize, hexes: &[[u32; 8]], v0: &[f64]| {
-            0.5 * (eps * v0[e]).min(volume(safe, e, hexes)).max(0.0)
-        };
-        // Elements outside the relaxed region are rigid copies of the fold's (valid).
-        let mut bad_el: Vec<usize> = (0..n_el)
-            .filter(|&e| {
-                self.fat.active[e]
-                    && volume(&self.fat.x, e, &self.fat.hexes)
-                        <= floor(e, &self.fat.hexes, &self.fat.rest_volume)
-            })
-            .collect();
-        let relaxed = self.fat.x.clone();
-        let mut share = vec![1.0f32; relaxed.len()];
-        let mut halvings = vec![0u8; relaxed.len()];
-        let mut bad = vec![false; relaxed.len()];
-        let mut moved_now = vec![false; relaxed.len()];
-        let mut moved_list: Vec<usize> = Vec::new();
-        for round in 0..GUARD_MAX_ROUNDS {
-            if round > 0 {
-                // Only elements touching a vertex just moved can have changed.
-                bad_el.clear();
-                for &v in &moved_list {
-                    bad_el.extend(self.fat.elements_of(v));
-                }
-                bad_el.sort_unstable();
-                bad_el.dedup();
-                bad_el.retain(|&e| {
-                    volume(&self.fat.x, e, &self.fat.hexes)
-                        <= floor(e, &self.fat.hexes, &self.fat.rest_volume)
-                });
-            }
-            for &e in &bad_el {
-                for &i in &self.fat.hexes[e] {
-                    bad[i as usize] = true;
-                }
-            }
-            if self.config.surface_guard {
-                // Triangles outside the relaxed region are where the fold put them (the
-                // tests check the fold's skin for crossings); after the first round only
-                // those with a vertex just moved can have changed.
-                let live = if round == 0 {
-                    &self.fat.free
-                } else {
-                    &moved_now
-                };
-                let active: Vec<bool> = self
-                    .guard_triangles
-                    .iter()
-                    .map(|t| t.iter().any(|&i| live[i as usize]))
-                    .collect();
-                let pairs = intersect::crossing_pairs_among(
-                    &self.fat.x,
-                    &self.guard_triangles,
-                    Some(&active),
-                );
-                for (a, b) in pairs {
-                    let (ta, tb) = (
-                        self.guard_triangles[a as usize],
-                        self.guard_triangles[b as usize],
-                    );
-                    for i in ta.iter().chain(&tb) {
-                        bad[*i as usize] = true;
-                    }
-                }
-            }
-            // Stop when nothing is wrong, or nothing is left to give back.
-            for &v in &moved_list {
-                moved_now[v] = false;
-            }
-            moved_list.clear();
-            for (i, b) in bad.iter_mut().enumerate() {
-                if std::mem::take(b) && share[i] > 0.0 {
-                    moved_now[i] = true;
-                    moved_list.push(i);
-                    halvings[i] += 1;
-                    share[i] = if halvings[i] >= GUARD_HALVINGS {
-                        0.0
-                    } else {
-                        0.5 * share[i]
-                    };
-                }
-            }
-            if moved_list.is_empty() {
-                break;
-            }
-            // The vertices around give back part of it too: a soft edge, not a step from
-            // one vertex to the next.
-            let n_bad = moved_list.len();
-            for k in 0..n_bad {
-                let v = moved_list[k];
-                let cap = 0.5 * (1.0 + share[v]);
-                for e in self.fat.elements_of(v) {
-                    for &u in &self.fat.hexes[e] {
-                        let u = u as usize;
-                        if share[u] > cap {
-                            share[u] = cap;
-                            if !moved_now[u] {
-                                moved_now[u] = true;
-                                moved_list.push(u);
-                            }
-                        }
-                    }
-                }
-            }
-            for &i in &moved_list {
-                self.fat.x[i] = safe[i] + (relaxed[i] - safe[i]) * share[i];
-            }
-            if round + 1 == GUARD_MAX_ROUNDS {
-                // Out of rounds (not seen in practice): whatever was touched takes the fold.
-                for (i, sh) in share.iter_mut().enumerate() {
-                    if *sh < 1.0 {
-                        *sh = 0.0;
-                        self.fat.x[i] = safe[i];
-                    }
-                }
-            }
-        }
-        share.iter().filter(|&&s| s < 1.0).count()
     }
 
     /// Whether the tissue has an update due after `dt` more seconds.

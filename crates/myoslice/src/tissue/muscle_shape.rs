@@ -3,7 +3,7 @@
 //! `sqrt(L0/L)` across and `L/L0` along when its chain segment goes from `L0` to `L`, so
 //! the local volume (and the muscle's) is kept.
 
-use glam::{Quat, Vec3};
+use glam::{Mat3, Quat, Vec3, Vec3A};
 
 use super::knee_fold::{Contact, KneeFold};
 use crate::lattice::{MuscleLattice, signed_volume};
@@ -33,6 +33,8 @@ pub struct MuscleShape {
     pub rest: Vec<Vec3>,
     /// Enclosed volume at rest (m³).
     pub rest_volume: f64,
+    /// Enclosed volume of the current shape (m³), as its last placement measured it.
+    pub volume_now: f64,
     /// Surface triangles (from the lattice).
     pub triangles: Vec<[u32; 3]>,
 }
@@ -101,6 +103,7 @@ impl MuscleShape {
             current: mesh.vertices.clone(),
             rest: mesh.vertices.clone(),
             rest_volume: mesh.volume().abs(),
+            volume_now: mesh.volume().abs(),
             triangles: mesh.triangles.clone(),
         }
     }
@@ -136,8 +139,9 @@ impl MuscleShape {
                 0.5 * (seg_len[a].0 + seg_len[b].0),
             )
         };
-        // Per ring: centre, turn and stretch (all its vertices share them).
-        let rings: Vec<(Vec3, Quat, Vec3, f32)> = self
+        // Per ring: centre, turn (as a matrix: one per ring, not per vertex) and stretch
+        // (all its vertices share them).
+        let rings: Vec<(Vec3, Mat3, Vec3, f32)> = self
             .ring_param
             .iter()
             .map(|&(s, t)| {
@@ -151,44 +155,62 @@ impl MuscleShape {
                     q = q.slerp(knee.rotation(centre_rest), near);
                 }
                 let c = chain.x[s].lerp(chain.x[s + 1], t);
-                (c, q, q * seg_len[s].1, lambda)
+                (c, Mat3::from_quat(q), q * seg_len[s].1, lambda)
             })
             .collect();
+        // Volumes are taken about a point inside the muscle: small coordinates keep the
+        // single-precision sum accurate.
+        let origin = chain.x[chain.x.len() / 2];
         let mut across_fix = 1.0f32;
         for pass in 0..VOLUME_PASSES {
             for (vi, p) in self.current.iter_mut().enumerate() {
-                let (c, q, axis_now, lambda) = rings[self.ring_of[vi] as usize];
+                let (c, m, axis_now, lambda) = rings[self.ring_of[vi] as usize];
                 let across = across_fix / lambda.sqrt();
-                *p = c + axis_now * (self.axial[vi] * lambda) + q * (self.perp[vi] * across);
+                *p = c + axis_now * (self.axial[vi] * lambda) + m * (self.perp[vi] * across);
             }
             if let Some(c) = contact {
                 for (p, r) in self.current.iter_mut().zip(&self.rest) {
                     *p = c.apply(*p, r.z >= knee.point.z, c.muscle_margin);
                 }
             }
-            if pass + 1 < VOLUME_PASSES {
-                // What the piecewise map still gains or loses, the cross-sections give
-                // back: one factor per muscle, the square root of the volume ratio.
-                let v = self.volume();
-                if v > 0.0 {
-                    across_fix *= ((self.rest_volume / v) as f32).sqrt();
-                }
-                if (((self.rest_volume / v.max(1e-15)) as f32).sqrt() - 1.0).abs() < 2e-4 {
-                    break;
-                }
+            // What the piecewise map still gains or loses, the cross-sections give back:
+            // one factor per muscle, the square root of the volume ratio.
+            let v = volume_about(&self.current, &self.triangles, origin);
+            self.volume_now = v;
+            let fix = ((self.rest_volume / v.max(1e-15)) as f32).sqrt();
+            if (fix - 1.0).abs() < 2e-4 || pass + 1 == VOLUME_PASSES || v <= 0.0 {
+                break;
             }
+            across_fix *= fix;
         }
     }
 
     /// Moves the whole shape rigidly with a body (rest → now).
     pub fn carry(&mut self, q: Quat, t: Vec3) {
+        let m = Mat3::from_quat(q);
         for (p, r) in self.current.iter_mut().zip(&self.rest) {
-            *p = q * *r + t;
+            *p = m * *r + t;
         }
+        self.volume_now = self.rest_volume;
     }
 
-    /// Enclosed volume now (m³).
+    /// Enclosed volume now (m³), measured anew.
     pub fn volume(&self) -> f64 {
         signed_volume(&self.current, &self.triangles).abs()
     }
+}
+
+/// Enclosed volume (m³) of a closed triangle surface, summed about `origin` in single
+/// precision per triangle (double across them).
+fn volume_about(vertices: &[Vec3], triangles: &[[u32; 3]], origin: Vec3) -> f64 {
+    let mut v = 0.0f64;
+    for chunk in triangles.chunks(64) {
+        let mut part = 0.0f32;
+        for t in chunk {
+            let [a, b, c] = t.map(|i| Vec3A::from(vertices[i as usize] - origin));
+            part += a.dot(b.cross(c));
+        }
+        v += f64::from(part);
+    }
+    (v / 6.0).abs()
 }

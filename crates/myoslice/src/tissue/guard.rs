@@ -1,0 +1,189 @@
+//! The validity guard (beyond the paper, which reports fat that breaks): where the relaxed
+//! fat has an element below its allowed volume, or body-surface triangles behind the
+//! knee that cross, the vertices involved give back half of their way from the knee fold
+//! (always valid) to the relaxed shape, round after round, and after [`HALVINGS`]
+//! halvings take the fold outright; the vertices around them give back part of the way
+//! too (a soft edge). Elsewhere the relaxed shape stands.
+//!
+//! After the first round only what the last round moved is looked at again.
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::fat_solver::FatSolver;
+use super::intersect::{Aabb, TriangleGrid, crossing_pairs_of_few};
+use crate::lattice::hex_volume_f32 as hex_volume;
+
+/// Times an offending vertex's relaxation is halved before it takes the fold outright.
+const HALVINGS: u8 = 1;
+
+/// Queried triangles up to which a round checks them without a grid.
+const FEW: usize = 64;
+
+/// Most rounds (each settles at least one more vertex).
+const MAX_ROUNDS: usize = 64;
+
+/// Reused buffers of the guard.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Guard {
+    relaxed: Vec<Vec3>,
+    share: Vec<f32>,
+    halvings: Vec<u8>,
+    bad: Vec<bool>,
+    moved_now: Vec<bool>,
+    moved_list: Vec<usize>,
+    bad_el: Vec<usize>,
+    boxes: Vec<Aabb>,
+    query: Vec<u32>,
+    live: Vec<bool>,
+}
+
+impl Guard {
+    /// Runs the guard on `fat` (relaxed), falling back toward `safe`; `triangles` are
+    /// the guarded body-surface triangles, `surface` whether to check them. Elements may
+    /// not shrink to half of `eps` × their rest volume (or half their fold volume, if
+    /// that is smaller). Returns how many vertices moved off the relaxed shape.
+    pub(crate) fn run(
+        &mut self,
+        fat: &mut FatSolver,
+        safe: &[Vec3],
+        triangles: &[[u32; 3]],
+        eps: f32,
+        surface: bool,
+    ) -> usize {
+        let n = fat.x.len();
+        self.relaxed.clone_from(&fat.x);
+        for v in [&mut self.bad, &mut self.moved_now] {
+            v.clear();
+            v.resize(n, false);
+        }
+        self.share.clear();
+        self.share.resize(n, 1.0);
+        self.halvings.clear();
+        self.halvings.resize(n, 0);
+        self.moved_list.clear();
+        let too_small = |x: &[Vec3], e: usize, fat: &FatSolver| {
+            let h = &fat.hexes[e];
+            let v = hex_volume(x, h);
+            let full = eps * fat.rest_volume[e] as f32;
+            // The fold's volume can only lower the floor: it matters below this one.
+            v <= 0.5 * full && v <= 0.5 * full.min(hex_volume(safe, h)).max(0.0)
+        };
+        // Elements outside the relaxed region are rigid copies of the fold's (valid).
+        self.bad_el = (0..fat.hexes.len())
+            .into_par_iter()
+            .filter(|&e| fat.active[e] && too_small(&fat.x, e, fat))
+            .collect();
+        // Triangles outside the relaxed region are where the fold put them (the tests
+        // check the fold's skin for crossings), so only pairs with a live triangle can
+        // cross.
+        if surface {
+            self.live.clear();
+            self.live.extend(
+                triangles
+                    .iter()
+                    .map(|t| t.iter().any(|&i| fat.free[i as usize])),
+            );
+        }
+        for round in 0..MAX_ROUNDS {
+            if round > 0 {
+                // Only elements touching a vertex just moved can have changed.
+                self.bad_el.clear();
+                for &v in &self.moved_list {
+                    self.bad_el.extend(fat.elements_of(v));
+                }
+                self.bad_el.sort_unstable();
+                self.bad_el.dedup();
+                let x = &fat.x;
+                self.bad_el.retain(|&e| too_small(x, e, fat));
+            }
+            for &e in &self.bad_el {
+                for &i in &fat.hexes[e] {
+                    self.bad[i as usize] = true;
+                }
+            }
+            if surface {
+                // After the first round only triangles with a vertex just moved can have
+                // changed.
+                if round > 0 {
+                    for (l, t) in self.live.iter_mut().zip(triangles) {
+                        *l = t.iter().any(|&i| self.moved_now[i as usize]);
+                    }
+                }
+                self.query.clear();
+                self.query
+                    .extend((0..triangles.len() as u32).filter(|&i| self.live[i as usize]));
+                self.boxes.clear();
+                self.boxes
+                    .extend(triangles.iter().map(|t| Aabb::of(&fat.x, t)));
+                let live = &self.live;
+                let queried = |i: u32| live[i as usize];
+                // A grid pays for itself only for many queries (the first round).
+                let pairs = if self.query.len() > FEW {
+                    TriangleGrid::new(&self.boxes, triangles, &fat.x).map_or_else(Vec::new, |g| {
+                        g.crossing_pairs(&fat.x, triangles, &self.boxes, &self.query, queried)
+                    })
+                } else {
+                    crossing_pairs_of_few(&fat.x, triangles, &self.boxes, &self.query, queried)
+                };
+                for (a, b) in pairs {
+                    for i in triangles[a as usize].iter().chain(&triangles[b as usize]) {
+                        self.bad[*i as usize] = true;
+                    }
+                }
+            }
+            // Stop when nothing is wrong, or nothing is left to give back.
+            for &v in &self.moved_list {
+                self.moved_now[v] = false;
+            }
+            self.moved_list.clear();
+            for (i, b) in self.bad.iter_mut().enumerate() {
+                if std::mem::take(b) && self.share[i] > 0.0 {
+                    self.moved_now[i] = true;
+                    self.moved_list.push(i);
+                    self.halvings[i] += 1;
+                    self.share[i] = if self.halvings[i] >= HALVINGS {
+                        0.0
+                    } else {
+                        0.5 * self.share[i]
+                    };
+                }
+            }
+            if self.moved_list.is_empty() {
+                break;
+            }
+            // The vertices around give back part of it too: a soft edge, not a step from
+            // one vertex to the next.
+            let n_bad = self.moved_list.len();
+            for k in 0..n_bad {
+                let v = self.moved_list[k];
+                let cap = 0.5 * (1.0 + self.share[v]);
+                for e in fat.elements_of(v) {
+                    for &u in &fat.hexes[e] {
+                        let u = u as usize;
+                        if self.share[u] > cap {
+                            self.share[u] = cap;
+                            if !self.moved_now[u] {
+                                self.moved_now[u] = true;
+                                self.moved_list.push(u);
+                            }
+                        }
+                    }
+                }
+            }
+            for &i in &self.moved_list {
+                fat.x[i] = safe[i] + (self.relaxed[i] - safe[i]) * self.share[i];
+            }
+            if round + 1 == MAX_ROUNDS {
+                // Out of rounds (not seen in practice): whatever was touched takes the fold.
+                for (i, sh) in self.share.iter_mut().enumerate() {
+                    if *sh < 1.0 {
+                        *sh = 0.0;
+                        fat.x[i] = safe[i];
+                    }
+                }
+            }
+        }
+        self.share.iter().filter(|&&s| s < 1.0).count()
+    }
+}
