@@ -20,21 +20,50 @@ pub(crate) struct BoneMesh {
     triangles: Vec<[u32; 3]>,
     /// Outward unit normal of each triangle.
     normals: Vec<Vec3>,
+    /// Pseudo-normal of each triangle's edges (ab, bc, ca): the sum of the two faces'.
+    edge_normals: Vec<[Vec3; 3]>,
+    /// Angle-weighted pseudo-normal of each vertex (Bærentzen and Aanæs 2005): which side
+    /// of the surface a point lies on, whatever feature is nearest it.
+    vertex_normals: Vec<Vec3>,
     /// The triangles sharing an edge with each triangle (u32::MAX: none).
     neighbours: Vec<[u32; 3]>,
+    /// The triangles around each vertex (CSR: `fan[fan_start[v]..fan_start[v + 1]]`).
+    fan_start: Vec<u32>,
+    fan: Vec<u32>,
+}
+
+/// Which part of a triangle a closest point lies on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Feature {
+    Face,
+    /// Edge from corner k to corner k + 1.
+    Edge(usize),
+    Vertex(usize),
 }
 
 impl BoneMesh {
+    /// The surface of a bone on `body` (closed, outward triangles).
     pub(crate) fn new(body: BodyId, mesh: &TriMesh) -> Self {
         let vertices = mesh.vertices().to_vec();
         let triangles = mesh.indices().to_vec();
-        let normals = triangles
+        let normals: Vec<Vec3> = triangles
             .iter()
             .map(|t| {
                 let [a, b, c] = t.map(|i| vertices[i as usize]);
                 (b - a).cross(c - a).normalize_or_zero()
             })
             .collect();
+        let mut vertex_normals = vec![Vec3::ZERO; vertices.len()];
+        for (t, n) in triangles.iter().zip(&normals) {
+            for k in 0..3 {
+                let p = vertices[t[k] as usize];
+                let (u, w) = (
+                    vertices[t[(k + 1) % 3] as usize] - p,
+                    vertices[t[(k + 2) % 3] as usize] - p,
+                );
+                vertex_normals[t[k] as usize] += *n * u.angle_between(w);
+            }
+        }
         let mut edges: Vec<((u32, u32), u32, u8)> = triangles
             .iter()
             .enumerate()
@@ -47,10 +76,36 @@ impl BoneMesh {
             .collect();
         edges.sort_unstable();
         let mut neighbours = vec![[u32::MAX; 3]; triangles.len()];
+        let mut edge_normals: Vec<[Vec3; 3]> = normals.iter().map(|n| [*n; 3]).collect();
         for w in edges.windows(2) {
             if w[0].0 == w[1].0 {
-                neighbours[w[0].1 as usize][w[0].2 as usize] = w[1].1;
-                neighbours[w[1].1 as usize][w[1].2 as usize] = w[0].1;
+                let (t0, k0, t1, k1) = (
+                    w[0].1 as usize,
+                    w[0].2 as usize,
+                    w[1].1 as usize,
+                    w[1].2 as usize,
+                );
+                neighbours[t0][k0] = t1 as u32;
+                neighbours[t1][k1] = t0 as u32;
+                let sum = normals[t0] + normals[t1];
+                (edge_normals[t0][k0], edge_normals[t1][k1]) = (sum, sum);
+            }
+        }
+        let mut fan_start = vec![0u32; vertices.len() + 1];
+        for t in &triangles {
+            for &v in t {
+                fan_start[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..vertices.len() {
+            fan_start[v + 1] += fan_start[v];
+        }
+        let mut fill = fan_start.clone();
+        let mut fan = vec![0u32; triangles.len() * 3];
+        for (ti, t) in triangles.iter().enumerate() {
+            for &v in t {
+                fan[fill[v as usize] as usize] = ti as u32;
+                fill[v as usize] += 1;
             }
         }
         Self {
@@ -58,13 +113,26 @@ impl BoneMesh {
             vertices,
             triangles,
             normals,
+            edge_normals,
+            vertex_normals,
             neighbours,
+            fan_start,
+            fan,
         }
     }
 
-    fn closest_on(&self, t: u32, p: Vec3) -> Vec3 {
+    fn closest_on(&self, t: u32, p: Vec3) -> (Vec3, Feature) {
         let [a, b, c] = self.triangles[t as usize].map(|i| self.vertices[i as usize]);
         closest_on_triangle(p, a, b, c)
+    }
+
+    /// The outward pseudo-normal at `feature` of triangle `t`.
+    fn pseudo_normal(&self, t: u32, feature: Feature) -> Vec3 {
+        match feature {
+            Feature::Face => self.normals[t as usize],
+            Feature::Edge(k) => self.edge_normals[t as usize][k],
+            Feature::Vertex(k) => self.vertex_normals[self.triangles[t as usize][k] as usize],
+        }
     }
 
     /// The nearest surface point to `p` (rest frame) found by walking from triangle
@@ -72,15 +140,24 @@ impl BoneMesh {
     fn walk(&self, start: u32, p: Vec3) -> (Vec3, u32, bool) {
         let mut cur = start.min(self.triangles.len() as u32 - 1);
         let mut best = self.closest_on(cur, p);
-        let mut d2 = best.distance_squared(p);
+        let mut d2 = best.0.distance_squared(p);
         for _ in 0..MAX_WALK {
             let mut next = None;
-            for &nb in &self.neighbours[cur as usize] {
-                if nb == u32::MAX {
+            // Across the edges, and all round a corner when the nearest point is one (a
+            // walk over edges alone can stall at a corner shared by many triangles).
+            let corner = match best.1 {
+                Feature::Vertex(k) => {
+                    let v = self.triangles[cur as usize][k] as usize;
+                    &self.fan[self.fan_start[v] as usize..self.fan_start[v + 1] as usize]
+                }
+                _ => &[],
+            };
+            for &nb in self.neighbours[cur as usize].iter().chain(corner) {
+                if nb == u32::MAX || nb == cur {
                     continue;
                 }
                 let q = self.closest_on(nb, p);
-                let d = q.distance_squared(p);
+                let d = q.0.distance_squared(p);
                 if d < d2 {
                     (best, d2, next) = (q, d, Some(nb));
                 }
@@ -90,42 +167,46 @@ impl BoneMesh {
                 None => break,
             }
         }
-        let inside = (p - best).dot(self.normals[cur as usize]) < 0.0;
-        (best, cur, inside)
+        let inside = (p - best.0).dot(self.pseudo_normal(cur, best.1)) < 0.0;
+        (best.0, cur, inside)
     }
 }
 
-/// Closest point of triangle `abc` to `p` (Ericson, Real-Time Collision Detection 5.1.5).
-fn closest_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+/// Closest point of triangle `abc` to `p` and the feature it lies on (Ericson, Real-Time
+/// Collision Detection 5.1.5).
+fn closest_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> (Vec3, Feature) {
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));
     if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
+        return (a, Feature::Vertex(0));
     }
     let bp = p - b;
     let (d3, d4) = (ab.dot(bp), ac.dot(bp));
     if d3 >= 0.0 && d4 <= d3 {
-        return b;
+        return (b, Feature::Vertex(1));
     }
     let vc = d1 * d4 - d3 * d2;
     if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
+        return (a + ab * (d1 / (d1 - d3)), Feature::Edge(0));
     }
     let cp = p - c;
     let (d5, d6) = (ab.dot(cp), ac.dot(cp));
     if d6 >= 0.0 && d5 <= d6 {
-        return c;
+        return (c, Feature::Vertex(2));
     }
     let vb = d5 * d2 - d1 * d6;
     if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
+        return (a + ac * (d2 / (d2 - d6)), Feature::Edge(2));
     }
     let va = d3 * d6 - d5 * d4;
     if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+        return (
+            b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))),
+            Feature::Edge(1),
+        );
     }
     let denom = 1.0 / (va + vb + vc);
-    a + ab * (vb * denom) + ac * (vc * denom)
+    (a + ab * (vb * denom) + ac * (vc * denom), Feature::Face)
 }
 
 /// The fat vertices that slide on bone, with their bone, rest distance and the triangle
@@ -192,7 +273,7 @@ mod tests {
     #[test]
     fn the_closest_point_of_a_triangle_is_found_in_each_region() {
         let (a, b, c) = (Vec3::ZERO, Vec3::X, Vec3::Y);
-        let near = |p: Vec3| closest_on_triangle(p, a, b, c);
+        let near = |p: Vec3| closest_on_triangle(p, a, b, c).0;
         assert!(near(Vec3::new(0.2, 0.2, 1.0)).distance(Vec3::new(0.2, 0.2, 0.0)) < 1e-6);
         assert_eq!(near(Vec3::new(-1.0, -1.0, 0.3)), a);
         assert_eq!(near(Vec3::new(2.0, -0.5, 0.0)), b);

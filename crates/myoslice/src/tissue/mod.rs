@@ -173,7 +173,7 @@ impl Tissue {
     ) -> Result<Self> {
         config.validate()?;
         let shapes: Vec<MuscleShape> = muscles
-            .iter()
+            .par_iter()
             .map(|m| MuscleShape::new(&lattice.muscles[m.lattice_index], &m.chain))
             .collect();
         let fat = &lattice.fat;
