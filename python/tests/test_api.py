@@ -117,8 +117,9 @@ def test_muscles_respond_to_excitation(rigid: Simulation) -> None:
     names = rigid.muscle_names
     hamstrings = [names.index(h) for h in HAMSTRINGS]
     vasti = [names.index(v) for v in ("vastus_lateralis", "vastus_medialis", "vastus_intermedius")]
-    # At rest the hamstrings flex the knee and the vasti extend it. (Moment arms are
-    # computed by step(): they read 0 before the first one.)
+    # At rest the hamstrings flex the knee and the vasti extend it, from the start.
+    assert np.all(rigid.moment_arms[hamstrings] > 0.0)
+    assert np.all(rigid.moment_arms[vasti] < 0.0)
     rigid.step(0.001)
     assert np.all(rigid.moment_arms[hamstrings] > 0.0)
     assert np.all(rigid.moment_arms[vasti] < 0.0)

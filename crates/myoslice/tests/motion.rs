@@ -405,6 +405,22 @@ fn moment_arms_equal_the_tendon_excursion() {
 }
 
 #[test]
+fn moment_arms_are_reported_from_the_start() {
+    let mut s = sim(config());
+    for when in ["before the first step", "after the first step"] {
+        for m in HAMSTRINGS {
+            let r = s.muscle(m).unwrap().moment_arm;
+            assert!(r > 0.01, "{m} {when}: moment arm {r} m");
+        }
+        for m in QUADRICEPS {
+            let r = s.muscle(m).unwrap().moment_arm;
+            assert!(r < -0.01, "{m} {when}: moment arm {r} m");
+        }
+        s.step(0.001).unwrap();
+    }
+}
+
+#[test]
 fn knee_torque_is_tendon_force_times_moment_arm() {
     let mut s = sim(config());
     s.set_knee(40f64.to_radians(), 0.0).unwrap();

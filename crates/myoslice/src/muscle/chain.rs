@@ -111,7 +111,7 @@ pub struct SegmentGeom {
 }
 
 /// A muscle's chain of mass points, origin (index 0) to insertion (last).
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct MuscleChain {
     /// Origin attachment.
     pub origin: Attachment,
@@ -148,6 +148,69 @@ pub struct MuscleChain {
     /// The body each point moves with (see [`Self::index_bodies`]): fixed once the chain
     /// is built, looked up every step.
     pub bodies: Vec<BodyId>,
+}
+
+impl Clone for MuscleChain {
+    fn clone(&self) -> Self {
+        let mut c = Self {
+            origin: self.origin,
+            insertion: self.insertion,
+            x: Vec::new(),
+            v: Vec::new(),
+            mass: Vec::new(),
+            rest_len: Vec::new(),
+            tendon: Vec::new(),
+            cones: Vec::new(),
+            vias: Vec::new(),
+            cone_cos_tan: self.cone_cos_tan,
+            wrap: self.wrap,
+            wrap_segment: self.wrap_segment,
+            wrapped: self.wrapped,
+            belly_rest: self.belly_rest,
+            scratch: ChainScratch::default(),
+            geom: Vec::new(),
+            bodies: Vec::new(),
+        };
+        c.clone_from(self);
+        c
+    }
+
+    /// Copies into the buffers already here (a step's rollback copy is taken every
+    /// call: this keeps it free of allocations). Work buffers are not copied.
+    fn clone_from(&mut self, o: &Self) {
+        // Every field named, so that a new one cannot be forgotten here.
+        let Self {
+            origin,
+            insertion,
+            x,
+            v,
+            mass,
+            rest_len,
+            tendon,
+            cones,
+            vias,
+            cone_cos_tan,
+            wrap,
+            wrap_segment,
+            wrapped,
+            belly_rest,
+            scratch: _,
+            geom,
+            bodies,
+        } = o;
+        (self.origin, self.insertion) = (*origin, *insertion);
+        self.x.clone_from(x);
+        self.v.clone_from(v);
+        self.mass.clone_from(mass);
+        self.rest_len.clone_from(rest_len);
+        self.tendon.clone_from(tendon);
+        self.cones.clone_from(cones);
+        self.vias.clone_from(vias);
+        (self.cone_cos_tan, self.wrap, self.wrap_segment) = (*cone_cos_tan, *wrap, *wrap_segment);
+        (self.wrapped, self.belly_rest) = (*wrapped, *belly_rest);
+        self.geom.clone_from(geom);
+        self.bodies.clone_from(bodies);
+    }
 }
 
 /// Work buffers of [`MuscleChain::advance`], kept to avoid allocating every step.

@@ -36,7 +36,7 @@ pub struct ChainOptions {
 }
 
 /// A muscle-tendon unit of the simulation.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct MuscleUnit {
     /// Name (label table).
     pub name: String,
@@ -73,6 +73,65 @@ pub struct MuscleUnit {
     pub moment_arm: f64,
     /// Moment arm at the chain's current geometry (m): the next step's.
     pub current_moment_arm: f64,
+}
+
+impl Clone for MuscleUnit {
+    fn clone(&self) -> Self {
+        let mut u = Self {
+            name: String::new(),
+            lattice_index: self.lattice_index,
+            group: self.group,
+            hill: self.hill,
+            chain: self.chain.clone(),
+            crosses_knee: self.crosses_knee,
+            mass: self.mass,
+            bones: Default::default(),
+            from_catalogue: self.from_catalogue,
+            excitation: self.excitation,
+            activation: self.activation,
+            path_length: self.path_length,
+            path_velocity: self.path_velocity,
+            force: self.force,
+            fibre: self.fibre,
+            moment_arm: self.moment_arm,
+            current_moment_arm: self.current_moment_arm,
+        };
+        u.clone_from(self);
+        u
+    }
+
+    /// Copies into the buffers already here (see [`MuscleChain`]'s `clone_from`).
+    fn clone_from(&mut self, o: &Self) {
+        // Every field named, so that a new one cannot be forgotten here.
+        let Self {
+            name,
+            lattice_index,
+            group,
+            hill,
+            chain,
+            crosses_knee,
+            mass,
+            bones,
+            from_catalogue,
+            excitation,
+            activation,
+            path_length,
+            path_velocity,
+            force,
+            fibre,
+            moment_arm,
+            current_moment_arm,
+        } = o;
+        self.name.clone_from(name);
+        self.bones.clone_from(bones);
+        self.chain.clone_from(chain);
+        (self.lattice_index, self.group, self.hill) = (*lattice_index, *group, *hill);
+        (self.crosses_knee, self.mass, self.from_catalogue) =
+            (*crosses_knee, *mass, *from_catalogue);
+        (self.excitation, self.activation, self.force) = (*excitation, *activation, *force);
+        (self.path_length, self.path_velocity, self.fibre) = (*path_length, *path_velocity, *fibre);
+        (self.moment_arm, self.current_moment_arm) = (*moment_arm, *current_moment_arm);
+    }
 }
 
 fn bone_index(lattice: &Lattice, name: &str) -> Option<usize> {

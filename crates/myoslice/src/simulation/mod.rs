@@ -85,6 +85,21 @@ pub struct Simulation {
     tissue: Option<Tissue>,
     /// Per-substep buffers, kept to avoid allocating every step.
     scratch: (Vec<(Vec3, Vec3)>, Vec<ChainLoad>),
+    /// Buffers for the state a `step` call started from.
+    rollback: Rollback,
+}
+
+/// The muscles as a `step` call found them, in buffers reused from call to call. A clone
+/// of the simulation starts with empty ones: they hold nothing between calls.
+#[derive(Debug, Default)]
+struct Rollback {
+    muscles: Vec<MuscleUnit>,
+}
+
+impl Clone for Rollback {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
 }
 
 impl Simulation {
@@ -152,7 +167,11 @@ impl Simulation {
             knee_torque: 0.0,
             tissue: None,
             scratch: Default::default(),
+            rollback: Rollback::default(),
         };
+        // Moment arms (each step's torque report uses the last step's) and wrap state of
+        // the chains as built.
+        sim.reattach_muscles();
         if let Some(bones) = bones {
             // The tissue's rest is the chains' equilibrium at rest (see `settle`); the
             // simulation itself starts from the chains as built.
@@ -485,37 +504,41 @@ impl Simulation {
         }
         let n = (dt / self.config.max_step_s).ceil().max(1.0) as usize;
         let h = dt / n as f64;
-        // The tissue keeps its own last good shape; the rest is cheap to keep here.
+        // The tissue keeps its own last good shape; the muscles are copied into buffers
+        // kept from call to call (a fresh copy would cost more than a 1 ms step).
+        let mut rollback = std::mem::take(&mut self.rollback);
+        rollback.muscles.clone_from(&self.muscles);
         let saved = (
             self.time,
             self.steps,
             self.skeleton.clone(),
-            self.muscles.clone(),
             self.frames,
             self.knee_torque,
         );
-        let restore = |sim: &mut Self, what: String| {
+        let restore = |sim: &mut Self, mut rollback: Rollback, what: String| {
             let t = sim.time;
             (
                 sim.time,
                 sim.steps,
                 sim.skeleton,
-                sim.muscles,
                 sim.frames,
                 sim.knee_torque,
             ) = saved.clone();
+            std::mem::swap(&mut sim.muscles, &mut rollback.muscles);
+            sim.rollback = rollback;
             Err(Error::NonFinite { time: t, what })
         };
         for _ in 0..n {
             self.substep(h);
             if let Some(what) = self.non_finite() {
-                return restore(self, what);
+                return restore(self, rollback, what);
             }
             let due = self.tissue.as_mut().is_some_and(|t| t.advance_clock(h));
             if due && self.update_tissue().is_err() {
-                return restore(self, "fat or muscle shape".into());
+                return restore(self, rollback, "fat or muscle shape".into());
             }
         }
+        self.rollback = rollback;
         Ok(())
     }
 
