@@ -510,7 +510,7 @@ impl MuscleChain {
             self.attach_ends(to);
             return 0;
         }
-        let h = dt;
+        let (h, inv_h) = (dt, 1.0 / dt);
         let damping = self.critical_damping(load);
         let mut sc = std::mem::take(&mut self.scratch);
         sc.fit(n);
@@ -518,11 +518,11 @@ impl MuscleChain {
         let old_ends = (self.x[0], self.x[n - 1]);
         self.x[0] = to.point(self.origin.body, self.origin.rest);
         self.x[n - 1] = to.point(self.insertion.body, self.insertion.rest);
-        self.v[0] = (self.x[0] - old_ends.0) / h;
-        self.v[n - 1] = (self.x[n - 1] - old_ends.1) / h;
+        self.v[0] = (self.x[0] - old_ends.0) * inv_h;
+        self.v[n - 1] = (self.x[n - 1] - old_ends.1) * inv_h;
         for (i, a) in &self.vias {
             let p = to.point(a.body, a.rest);
-            self.v[*i] = (p - self.x[*i]) / h;
+            self.v[*i] = (p - self.x[*i]) * inv_h;
             self.x[*i] = p;
         }
         self.refresh_pinned();
@@ -568,7 +568,7 @@ impl MuscleChain {
                 let p = project_into_cone(self.x[i], apex, axis, self.cone_cos_tan);
                 self.x[i] = clamp_depth(p, apex, c.depth);
                 // Position-based correction: the velocity follows the projected motion.
-                self.v[i] = (self.x[i] - old) / h;
+                self.v[i] = (self.x[i] - old) * inv_h;
             }
         }
         self.update_wrap();
