@@ -109,18 +109,21 @@ pub fn hex_volume(v: &[Vec3], h: &[u32; 8]) -> f64 {
     hex_volume_points(&p)
 }
 
+/// The six tetrahedra of a hexahedron (VTK corner order) about its 0–6 diagonal, as the
+/// corners each makes with corner 0.
+const HEX_TETS: [[usize; 3]; 6] = [
+    [1, 2, 6],
+    [2, 3, 6],
+    [3, 7, 6],
+    [7, 4, 6],
+    [4, 5, 6],
+    [5, 1, 6],
+];
+
 /// Signed volume of eight hexahedron corners in VTK order.
 pub fn hex_volume_points(p: &[DVec3; 8]) -> f64 {
-    const TETS: [[usize; 3]; 6] = [
-        [1, 2, 6],
-        [2, 3, 6],
-        [3, 7, 6],
-        [7, 4, 6],
-        [4, 5, 6],
-        [5, 1, 6],
-    ];
     let mut vol = 0.0;
-    for t in TETS {
+    for t in HEX_TETS {
         let (a, b, c) = (p[t[0]] - p[0], p[t[1]] - p[0], p[t[2]] - p[0]);
         vol += a.dot(b.cross(c));
     }
@@ -131,17 +134,10 @@ pub fn hex_volume_points(p: &[DVec3; 8]) -> f64 {
 /// single precision: for the per-update checks, whose thresholds are percents of the
 /// rest volume.
 pub fn hex_volume_f32(x: &[Vec3], h: &[u32; 8]) -> f32 {
-    const TETS: [[usize; 3]; 6] = [
-        [1, 2, 6],
-        [2, 3, 6],
-        [3, 7, 6],
-        [7, 4, 6],
-        [4, 5, 6],
-        [5, 1, 6],
-    ];
     let p0 = x[h[0] as usize];
     let p = h.map(|i| glam::Vec3A::from(x[i as usize] - p0));
-    TETS.iter()
+    HEX_TETS
+        .iter()
         .map(|t| p[t[0]].dot(p[t[1]].cross(p[t[2]])))
         .sum::<f32>()
         / 6.0
