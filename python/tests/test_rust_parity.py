@@ -28,7 +28,7 @@ OVERHEAD_FILE = Path(__file__).resolve().parent / ".last_overhead.txt"
 
 EXCITE = {"semimembranosus": 0.7, "vastus_lateralis": 0.2}
 # Timings take the best of this many interleaved runs (more help on a busy machine).
-RUNS = int(os.environ.get("MYOSLICE_TIMING_RUNS", "5"))
+RUNS = int(os.environ.get("MYOSLICE_TIMING_RUNS", "9"))
 
 
 def cli() -> Path:

@@ -318,16 +318,6 @@ impl Skeleton {
         );
     }
 
-    /// Linear velocity of the shank's centre of mass, its angular velocity and the centre
-    /// of mass itself (world): a point p moves at `v + w × (p − c)`.
-    pub fn shank_motion(&self) -> (Vec3, Vec3, Vec3) {
-        self.bodies
-            .get(self.shank)
-            .map_or((Vec3::ZERO, Vec3::ZERO, Vec3::ZERO), |b| {
-                (b.linvel(), b.angvel(), b.center_of_mass())
-            })
-    }
-
     /// Velocity (world, m/s) of the shank material point now at world position `p`.
     pub fn shank_point_velocity(&self, p: Vec3) -> Vec3 {
         self.bodies

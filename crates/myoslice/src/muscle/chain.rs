@@ -88,15 +88,6 @@ impl BodyFrames {
     pub fn vector(&self, b: BodyId, v: Vec3) -> Vec3 {
         self.of(b).0 * v
     }
-
-    /// Linear blend of two frames (for substeps; rotations by nlerp).
-    pub fn lerp(&self, o: &Self, t: f32) -> Self {
-        let l = |a: (Quat, Vec3), b: (Quat, Vec3)| (a.0.lerp(b.0, t).normalize(), a.1.lerp(b.1, t));
-        Self {
-            thigh: l(self.thigh, o.thigh),
-            shank: l(self.shank, o.shank),
-        }
-    }
 }
 
 /// Per-segment geometry of the current chain.
@@ -299,21 +290,11 @@ impl MuscleChain {
 
     #[inline]
     fn refresh_segment(&mut self, i: usize, update_wrap: bool) {
-        self.geom[i] = if i == self.wrap_segment
-            && let Some(w) = &self.wrap
-        {
-            let path = w.path(self.x[i], self.x[i + 1], self.wrapped);
-            if update_wrap {
-                self.wrapped = path.wrapped;
-            }
-            SegmentGeom {
-                length: path.length,
-                dir_a: path.dir_p,
-                dir_b: path.dir_q,
-            }
-        } else {
-            straight_segment(self.x[i], self.x[i + 1])
-        };
+        let (g, wrapped) = self.segment_now(i);
+        self.geom[i] = g;
+        if update_wrap && let Some(w) = wrapped {
+            self.wrapped = w;
+        }
     }
 
     /// The geometry after only the pinned points (ends, via points) moved: the segments
@@ -340,23 +321,29 @@ impl MuscleChain {
 
     /// Geometry of segment `i` (between points i and i+1); the knee-crossing one may wrap.
     fn compute_segment(&self, i: usize) -> SegmentGeom {
+        self.segment_now(i).0
+    }
+
+    /// Geometry of segment `i` now, and for the knee-crossing segment whether it wraps.
+    fn segment_now(&self, i: usize) -> (SegmentGeom, Option<bool>) {
         let (a, b) = (self.x[i], self.x[i + 1]);
-        if i == self.wrap_segment
-            && let Some(w) = &self.wrap
-        {
-            let WrapPath {
-                length,
-                dir_p,
-                dir_q,
-                ..
-            } = w.path(a, b, self.wrapped);
-            return SegmentGeom {
-                length,
-                dir_a: dir_p,
-                dir_b: dir_q,
-            };
+        match &self.wrap {
+            Some(w) if i == self.wrap_segment => {
+                let WrapPath {
+                    length,
+                    dir_p,
+                    dir_q,
+                    wrapped,
+                } = w.path(a, b, self.wrapped);
+                let g = SegmentGeom {
+                    length,
+                    dir_a: dir_p,
+                    dir_b: dir_q,
+                };
+                (g, Some(wrapped))
+            }
+            _ => (straight_segment(a, b), None),
         }
-        straight_segment(a, b)
     }
 
     /// Path length origin to insertion (m), wrapping included.
@@ -391,20 +378,6 @@ impl MuscleChain {
     /// changing any of them).
     pub fn index_bodies(&mut self) {
         self.bodies = (0..self.x.len()).map(|i| self.body_of_point(i)).collect();
-    }
-
-    /// Path lengthening velocity (m/s) due to the bones' motion alone: every point moving
-    /// with its body. This is the excursion the fibres see; the chain's own shape
-    /// relaxation is left out so it cannot feed back into the force-velocity relation.
-    pub fn anchored_path_velocity(&self, velocity_of: impl Fn(BodyId, Vec3) -> Vec3) -> f64 {
-        (0..self.x.len() - 1)
-            .map(|i| {
-                let g = self.segment(i);
-                let va = velocity_of(self.point_body(i), self.x[i]);
-                let vb = velocity_of(self.point_body(i + 1), self.x[i + 1]);
-                -f64::from(va.dot(g.dir_a) + vb.dot(g.dir_b))
-            })
-            .sum()
     }
 
     /// Current belly length (m).
@@ -502,13 +475,12 @@ impl MuscleChain {
     /// Advances the interior points by `dt` while the bodies move to `to`:
     /// Eq. 1 with gravity, integrated by linearly implicit (backward) Euler so that stiff
     /// springs and large contraction forces stay stable at the 1 kHz step, then the cone
-    /// projection. Returns the number of substeps taken (one: backward Euler is stable at
-    /// any step).
-    pub fn advance(&mut self, dt: f32, to: &BodyFrames, load: &ChainLoad) -> usize {
+    /// projection (one step: backward Euler is stable at any step).
+    pub fn advance(&mut self, dt: f32, to: &BodyFrames, load: &ChainLoad) {
         let n = self.x.len();
         if n < 3 {
             self.attach_ends(to);
-            return 0;
+            return;
         }
         let (h, inv_h) = (dt, 1.0 / dt);
         let damping = self.critical_damping(load);
@@ -573,7 +545,6 @@ impl MuscleChain {
         }
         self.update_wrap();
         self.scratch = sc;
-        1
     }
 
     /// Critical damping of the stiffest mode of the lightest point.

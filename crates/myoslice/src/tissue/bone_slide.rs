@@ -32,6 +32,19 @@ pub(crate) struct BoneMesh {
     fan: Vec<u32>,
 }
 
+/// Where a walk over a bone surface ended.
+#[derive(Debug, Clone, Copy)]
+struct Walk {
+    /// The nearest surface point it found.
+    point: Vec3,
+    /// The triangle that point lies on.
+    triangle: u32,
+    /// Whether the query point lies inside the bone (by the pseudo-normal there).
+    inside: bool,
+    /// Whether it stopped at a local minimum of the distance (else it ran out of steps).
+    settled: bool,
+}
+
 /// Which part of a triangle a closest point lies on.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Feature {
@@ -55,6 +68,10 @@ impl BoneMesh {
             .collect();
         let mut vertex_normals = vec![Vec3::ZERO; vertices.len()];
         for (t, n) in triangles.iter().zip(&normals) {
+            // A collapsed triangle has no normal to give (and its angles are not numbers).
+            if *n == Vec3::ZERO {
+                continue;
+            }
             for k in 0..3 {
                 let p = vertices[t[k] as usize];
                 let (u, w) = (
@@ -136,11 +153,12 @@ impl BoneMesh {
     }
 
     /// The nearest surface point to `p` (rest frame) found by walking from triangle
-    /// `start`, the triangle it lies on, and whether `p` is inside the bone.
-    fn walk(&self, start: u32, p: Vec3) -> (Vec3, u32, bool) {
-        let mut cur = start.min(self.triangles.len() as u32 - 1);
+    /// `start` (see [`Walk`]).
+    fn walk(&self, start: u32, p: Vec3) -> Walk {
+        let mut cur = start.min(self.triangles.len().saturating_sub(1) as u32);
         let mut best = self.closest_on(cur, p);
         let mut d2 = best.0.distance_squared(p);
+        let mut settled = false;
         for _ in 0..MAX_WALK {
             let mut next = None;
             // Across the edges, and all round a corner when the nearest point is one (a
@@ -164,11 +182,18 @@ impl BoneMesh {
             }
             match next {
                 Some(nb) => cur = nb,
-                None => break,
+                None => {
+                    settled = true;
+                    break;
+                }
             }
         }
-        let inside = (p - best.0).dot(self.pseudo_normal(cur, best.1)) < 0.0;
-        (best.0, cur, inside)
+        Walk {
+            point: best.0,
+            triangle: cur,
+            inside: (p - best.0).dot(self.pseudo_normal(cur, best.1)) < 0.0,
+            settled,
+        }
     }
 }
 
@@ -242,6 +267,7 @@ impl BoneSlide {
         x: &mut [Vec3],
         free: &[bool],
         meshes: &[BoneMesh],
+        surfaces: &[(BodyId, TriMesh)],
         pose: impl Fn(BodyId) -> (Quat, Vec3),
     ) {
         for (k, &(v, b, d0)) in self.vertices.iter().enumerate() {
@@ -251,17 +277,26 @@ impl BoneSlide {
             let mesh = &meshes[b as usize];
             let (q, t) = pose(mesh.body);
             let p_rest = q.inverse() * (x[v as usize] - t);
-            let (on, tri, inside) = mesh.walk(self.nearest[k], p_rest);
-            self.nearest[k] = tri;
-            let out = if inside {
-                (on - p_rest).normalize_or_zero()
+            let mut w = mesh.walk(self.nearest[k], p_rest);
+            if w.inside || !w.settled {
+                // A walk can stop at a nearest point that is only local (across a
+                // concave part of the bone): before pulling a vertex through to the
+                // other side, or when the walk ran out of steps, ask the tree.
+                let (_, (tri, _)) = surfaces[b as usize]
+                    .1
+                    .project_local_point_and_get_location(p_rest, false);
+                w = mesh.walk(tri, p_rest);
+            }
+            self.nearest[k] = w.triangle;
+            let out = if w.inside {
+                (w.point - p_rest).normalize_or_zero()
             } else {
-                (p_rest - on).normalize_or_zero()
+                (p_rest - w.point).normalize_or_zero()
             };
             // Slide on the bone: pulled onto the surface (at its rest distance), softly.
-            let target = q * (on + out * d0) + t;
+            let target = q * (w.point + out * d0) + t;
             let cur = x[v as usize];
-            x[v as usize] = cur + (target - cur) * if inside { 1.0 } else { 0.7 };
+            x[v as usize] = cur + (target - cur) * if w.inside { 1.0 } else { 0.7 };
         }
     }
 }
@@ -269,6 +304,47 @@ impl BoneSlide {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A unit cube, outward triangles.
+    fn cube() -> BoneMesh {
+        let v: Vec<Vec3> = (0..8)
+            .map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32))
+            .collect();
+        let quads = [
+            [0, 2, 3, 1], // z = 0, normal −z
+            [4, 5, 7, 6], // z = 1
+            [0, 1, 5, 4], // y = 0
+            [2, 6, 7, 3], // y = 1
+            [0, 4, 6, 2], // x = 0
+            [1, 3, 7, 5], // x = 1
+        ];
+        let t: Vec<[u32; 3]> = quads
+            .iter()
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .collect();
+        BoneMesh::new(
+            BodyId::Thigh,
+            &TriMesh::new(v, t).unwrap_or_else(|e| panic!("{e}")),
+        )
+    }
+
+    #[test]
+    fn a_walk_finds_the_nearest_point_and_the_side_from_any_start() {
+        let m = cube();
+        for start in 0..12 {
+            // Just inside the top face, near its middle.
+            let w = m.walk(start, Vec3::new(0.5, 0.4, 0.98));
+            assert!(w.settled && w.inside, "start {start}: {w:?}");
+            assert!(w.point.distance(Vec3::new(0.5, 0.4, 1.0)) < 1e-5, "{w:?}");
+            // Outside beyond a corner (the nearest feature is a vertex of six triangles).
+            let w = m.walk(start, Vec3::new(1.2, 1.3, 1.1));
+            assert!(w.settled && !w.inside, "start {start}: {w:?}");
+            assert!(w.point.distance(Vec3::ONE) < 1e-5, "{w:?}");
+            // Outside beyond an edge.
+            let w = m.walk(start, Vec3::new(-0.1, 0.5, -0.2));
+            assert!(!w.inside && w.point.distance(Vec3::new(0.0, 0.5, 0.0)) < 1e-5);
+        }
+    }
 
     #[test]
     fn the_closest_point_of_a_triangle_is_found_in_each_region() {

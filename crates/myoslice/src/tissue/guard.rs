@@ -1,9 +1,9 @@
 //! The validity guard (beyond the paper, which reports fat that breaks): where the relaxed
 //! fat has an element below its allowed volume, or body-surface triangles behind the
-//! knee that cross, the vertices involved give back half of their way from the knee fold
-//! (always valid) to the relaxed shape, round after round, and after [`HALVINGS`]
-//! halvings take the fold outright; the vertices around them give back part of the way
-//! too (a soft edge). Elsewhere the relaxed shape stands.
+//! knee that cross, the vertices involved take their place in the knee fold (always
+//! valid), and the vertices around them give back half of their way to it (a soft edge);
+//! what that moved is checked again, round after round. Elsewhere the relaxed shape
+//! stands.
 //!
 //! After the first round only what the last round moved is looked at again.
 
@@ -13,9 +13,6 @@ use rayon::prelude::*;
 use super::fat_solver::FatSolver;
 use super::intersect::{Aabb, TriangleGrid, crossing_pairs_of_few};
 use crate::lattice::hex_volume_f32 as hex_volume;
-
-/// Times an offending vertex's relaxation is halved before it takes the fold outright.
-const HALVINGS: u8 = 1;
 
 /// Queried triangles up to which a round checks them without a grid.
 const FEW: usize = 64;
@@ -28,7 +25,6 @@ const MAX_ROUNDS: usize = 64;
 pub(crate) struct Guard {
     relaxed: Vec<Vec3>,
     share: Vec<f32>,
-    halvings: Vec<u8>,
     bad: Vec<bool>,
     moved_now: Vec<bool>,
     moved_list: Vec<usize>,
@@ -59,8 +55,6 @@ impl Guard {
         }
         self.share.clear();
         self.share.resize(n, 1.0);
-        self.halvings.clear();
-        self.halvings.resize(n, 0);
         self.moved_list.clear();
         let too_small = |x: &[Vec3], e: usize, fat: &FatSolver| {
             let h = &fat.hexes[e];
@@ -141,12 +135,7 @@ impl Guard {
                 if std::mem::take(b) && self.share[i] > 0.0 {
                     self.moved_now[i] = true;
                     self.moved_list.push(i);
-                    self.halvings[i] += 1;
-                    self.share[i] = if self.halvings[i] >= HALVINGS {
-                        0.0
-                    } else {
-                        0.5 * self.share[i]
-                    };
+                    self.share[i] = 0.0;
                 }
             }
             if self.moved_list.is_empty() {

@@ -101,11 +101,19 @@ impl TriangleGrid {
             .map(|t| f64::from(vertices[t[0] as usize].distance(vertices[t[1] as usize])))
             .sum::<f64>()
             / triangles.len().max(1) as f64;
-        let cell = (1.0 * mean_edge as f32).max(1e-6);
+        let cell = (mean_edge as f32).max(1e-6);
         // At most ~64 cells per triangle on average: keeps the grid small for any input.
         let cell = cell.max(((hi - lo).element_product() / (64.0 * boxes.len() as f32)).cbrt());
+        // At most 1024 cells a side and 2^24 in all, whatever the input (a flat or huge
+        // set of boxes would otherwise overflow the count).
+        let mut cell = cell;
+        while ((hi - lo) / cell).max_element() >= 1024.0
+            || ((hi - lo) / cell + 1.0).element_product() >= (1u32 << 24) as f32
+        {
+            cell *= 2.0;
+        }
         let dims = ((hi - lo) / cell).as_uvec3() + 1;
-        let n_cells = (dims.x * dims.y * dims.z) as usize;
+        let n_cells = dims.x as usize * dims.y as usize * dims.z as usize;
         let mut g = Self {
             lo,
             inv_cell: 1.0 / cell,
@@ -268,9 +276,14 @@ fn clearly_one_side(a: &[Vec3; 3], b: &[Vec3; 3]) -> bool {
     let (e1, e2) = (b[1] - b[0], b[2] - b[0]);
     let n = e1.cross(e2);
     let d = a.map(|p| n.dot(p - b[0]));
-    // |n| ~ edge², distances ~ edge³: rounding is ~1e-6 of edge³ at worst.
+    // |n| ~ b's edge², the distances ~ that times how far a's corners lie from b's:
+    // rounding is ~1e-6 of their product at worst.
     let scale = e1.length_squared().max(e2.length_squared());
-    let margin = 1e-4 * scale * scale.sqrt();
+    let reach = a
+        .iter()
+        .map(|p| p.distance_squared(b[0]))
+        .fold(scale, f32::max);
+    let margin = 1e-4 * scale * reach.sqrt();
     (d[0] > margin && d[1] > margin && d[2] > margin)
         || (d[0] < -margin && d[1] < -margin && d[2] < -margin)
 }
@@ -318,6 +331,67 @@ fn triangles_cross(a: &[DVec3; 3], b: &[DVec3; 3]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A crumpled 12 × 12 sheet folded over itself: many crossing pairs.
+    fn crumpled() -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let mut seed = 12345u32;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (seed >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+        };
+        let n = 13;
+        let mut v = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                // Folded in two along x, with noise: the halves pass through each other.
+                let (x, y) = (i as f32 * 0.1, j as f32 * 0.1);
+                let fx = if x > 0.6 { 1.2 - x } else { x };
+                v.push(Vec3::new(
+                    fx + 0.03 * rnd(),
+                    y,
+                    0.02 * (x * 9.0).sin() + 0.04 * rnd(),
+                ));
+            }
+        }
+        let mut t = Vec::new();
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                let k = (j * n + i) as u32;
+                t.push([k, k + 1, k + n as u32 + 1]);
+                t.push([k, k + n as u32 + 1, k + n as u32]);
+            }
+        }
+        (v, t)
+    }
+
+    #[test]
+    fn the_grid_and_the_few_triangle_search_find_exactly_the_crossing_pairs() {
+        let (v, t) = crumpled();
+        let boxes: Vec<Aabb> = t.iter().map(|tri| Aabb::of(&v, tri)).collect();
+        let grid = TriangleGrid::new(&boxes, &t, &v).unwrap_or_else(|| panic!("a grid"));
+        for stride in [1, 3, 7, 50] {
+            let query: Vec<u32> = (0..t.len() as u32)
+                .filter(|i| i.is_multiple_of(stride))
+                .collect();
+            let queried = |i: u32| i.is_multiple_of(stride);
+            // Every pair, by brute force.
+            let mut want = Vec::new();
+            for a in 0..t.len() as u32 {
+                for b in a + 1..t.len() as u32 {
+                    if (queried(a) || queried(b))
+                        && let Some(p) = crossing(&v, &t, a, b)
+                    {
+                        want.push(p);
+                    }
+                }
+            }
+            let by_grid = grid.crossing_pairs(&v, &t, &boxes, &query, queried);
+            let by_few = crossing_pairs_of_few(&v, &t, &boxes, &query, queried);
+            assert!(!want.is_empty(), "the sheet crosses itself");
+            assert_eq!(by_grid, want, "grid, every {stride}th triangle queried");
+            assert_eq!(by_few, want, "few, every {stride}th triangle queried");
+        }
+    }
 
     #[test]
     fn crossing_triangles_are_found_and_separate_ones_are_not() {

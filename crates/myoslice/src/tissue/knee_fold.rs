@@ -241,7 +241,7 @@ pub struct FoldZone {
     kind: Vec<u8>,
     /// Per vertex, its place in the knee's frame and the angle-free parts of its weight.
     points: Vec<FoldPoint>,
-    /// Elements with a corner in the zone.
+    /// Elements that can bend: a corner in the zone, or corners on both bones.
     elements: Vec<u32>,
 }
 
@@ -267,8 +267,13 @@ impl FoldZone {
                 }
             })
             .collect();
+        // Elements with a corner in the zone, or (not seen in a lattice, whose slices are
+        // closer than the zone is tall) with corners fixed to both bones.
         let elements = (0..hexes.len() as u32)
-            .filter(|&e| hexes[e as usize].iter().any(|&v| kind[v as usize] == ZONE))
+            .filter(|&e| {
+                let k = hexes[e as usize].map(|v| kind[v as usize]);
+                k.iter().any(|&c| c == ZONE || c != k[0])
+            })
             .collect();
         Self {
             kind,
@@ -282,7 +287,7 @@ impl FoldZone {
         self.kind[v] == ZONE
     }
 
-    /// Elements with a corner in the zone (the others move rigidly).
+    /// Elements that can bend (the others move rigidly with one bone).
     pub fn elements(&self) -> &[u32] {
         &self.elements
     }

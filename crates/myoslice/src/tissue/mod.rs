@@ -120,12 +120,15 @@ struct TissueStatic {
     zone: FoldZone,
     /// Bone surfaces with adjacency, lattice bone order.
     bone_meshes: Vec<BoneMesh>,
+    /// The same surfaces as parry meshes (with a tree, for the rare global query).
+    bones: BoneSurfaces,
     /// Outer (skin) face of each outer-layer element and its rest area (m²).
     outer_faces: Vec<(u32, [u32; 4], f64)>,
 }
 
-/// Buffers an update fills anew each time, kept to avoid allocating them.
-#[derive(Debug, Clone, Default)]
+/// Buffers an update fills anew each time, kept to avoid allocating them. A copy of the
+/// tissue (a checkpoint) starts with empty ones: they hold nothing between updates.
+#[derive(Debug, Default)]
 struct Scratch {
     /// The knee fold of the rest shape (world): valid, the guard's fallback.
     safe: Vec<Vec3>,
@@ -137,6 +140,12 @@ struct Scratch {
     /// Where each inner vertex facing a muscle is pulled this update.
     muscle_targets: Vec<(u32, Vec3)>,
     guard: Guard,
+}
+
+impl Clone for Scratch {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
 }
 
 /// The deformable tissue of a simulation.
@@ -231,6 +240,7 @@ impl Tissue {
             guard_triangles,
             zone: FoldZone::new(&knee, &fat.vertices, &fat.hexes),
             bone_meshes: bones.iter().map(|(b, m)| BoneMesh::new(*b, m)).collect(),
+            bones: Arc::clone(&bones),
             outer_faces,
         };
         let mut tissue = Self {
@@ -435,8 +445,13 @@ impl Tissue {
             BodyId::Thigh => frames.thigh,
             BodyId::Shank => frames.shank,
         };
-        self.bone_slide
-            .apply(&mut self.fat.x, &self.fat.free, &fixed.bone_meshes, pose);
+        self.bone_slide.apply(
+            &mut self.fat.x,
+            &self.fat.free,
+            &fixed.bone_meshes,
+            &fixed.bones,
+            pose,
+        );
         self.apply_contact(&contact, gap);
         let guarded = sc.guard.run(
             &mut self.fat,
