@@ -6,4 +6,4 @@ pub mod skeleton;
 
 pub use knee::{KneeAxis, knee_axis};
 pub use segments::{SegmentInertia, shank_and_foot, thigh};
-pub use skeleton::{BodyId, Skeleton, SkeletonOptions, body_of_bone};
+pub use skeleton::{BodyId, Skeleton, SkeletonOptions, SkeletonSnapshot, body_of_bone};

@@ -25,6 +25,10 @@ use crate::tissue::{Tissue, TissueMetrics, bone_surfaces};
 /// Simulated time (s) the muscle chains settle at rest before time 0 (see `settle`).
 const SETTLE_S: f64 = 2.0;
 
+/// Largest force (N) one muscle may apply to the shank: a hundred times the strongest
+/// human muscle's; beyond it the step has blown up.
+const MAX_BODY_FORCE_N: f32 = 1e6;
+
 /// What a muscle reports.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MuscleReadout {
@@ -201,8 +205,7 @@ impl Simulation {
         let h = self.config.max_step_s;
         let n = (SETTLE_S / h).ceil() as usize;
         for _ in 0..n {
-            self.substep(h);
-            if self.non_finite().is_some() {
+            if self.substep(h).or_else(|| self.non_finite()).is_some() {
                 // A model that cannot rest (absurd muscle parameters) starts unsettled;
                 // stepping will report it.
                 self.muscles = muscles;
@@ -505,32 +508,22 @@ impl Simulation {
         let n = (dt / self.config.max_step_s).ceil().max(1.0) as usize;
         let h = dt / n as f64;
         // The tissue keeps its own last good shape; the muscles are copied into buffers
-        // kept from call to call (a fresh copy would cost more than a 1 ms step).
+        // kept from call to call (a fresh copy would cost more than a 1 ms step), the
+        // skeleton by its joint state (a clone of the rapier world would cost a seventh).
         let mut rollback = std::mem::take(&mut self.rollback);
         rollback.muscles.clone_from(&self.muscles);
-        let saved = (
-            self.time,
-            self.steps,
-            self.skeleton.clone(),
-            self.frames,
-            self.knee_torque,
-        );
+        let skeleton = self.skeleton.snapshot();
+        let saved = (self.time, self.steps, self.frames, self.knee_torque);
         let restore = |sim: &mut Self, mut rollback: Rollback, what: String| {
             let t = sim.time;
-            (
-                sim.time,
-                sim.steps,
-                sim.skeleton,
-                sim.frames,
-                sim.knee_torque,
-            ) = saved.clone();
+            (sim.time, sim.steps, sim.frames, sim.knee_torque) = saved;
+            sim.skeleton.restore(&skeleton);
             std::mem::swap(&mut sim.muscles, &mut rollback.muscles);
             sim.rollback = rollback;
             Err(Error::NonFinite { time: t, what })
         };
         for _ in 0..n {
-            self.substep(h);
-            if let Some(what) = self.non_finite() {
+            if let Some(what) = self.substep(h).or_else(|| self.non_finite()) {
                 return restore(self, rollback, what);
             }
             let due = self.tissue.as_mut().is_some_and(|t| t.advance_clock(h));
@@ -557,7 +550,8 @@ impl Simulation {
         None
     }
 
-    fn substep(&mut self, h: f64) {
+    /// One step of the muscles and the skeleton; says what failed if it could not run.
+    fn substep(&mut self, h: f64) -> Option<String> {
         let gravity = self.skeleton.gravity();
         let knee = *self.skeleton.knee();
         let hill = self.config.muscle_model == MuscleModel::Hill;
@@ -646,6 +640,17 @@ impl Simulation {
             torque += tau;
         }
         self.knee_torque = torque;
+        // Rapier quarantines (disables) a body whose pose turns non-finite, which only a
+        // full copy of its world could undo; no muscle pulls with a meganewton, so such
+        // a force is refused before rapier sees it and the step fails cleanly.
+        let unbounded = forces
+            .iter()
+            .find(|(f, at)| !(f.length() <= MAX_BODY_FORCE_N && at.is_finite()));
+        if let Some(&(f, _)) = unbounded {
+            let what = format!("a muscle force of {} N on the shank", f.length());
+            self.scratch = (forces, loads);
+            return Some(what);
+        }
         self.skeleton.step(h, &forces);
         let next = self.current_frames();
         // The thigh is fixed: the shank turns about the knee axis, so the path lengthens at
@@ -692,6 +697,7 @@ impl Simulation {
         self.time += h;
         self.steps += 1;
         self.scratch = (forces, loads);
+        None
     }
 
     /// A checkpoint of everything that changes while stepping.
