@@ -4,7 +4,7 @@ no slower.
 The reference is ``myoslice probe`` of ``<repo>/target/release/myoslice`` (build it with
 ``cargo build --release -p myoslice-cli``). A missing binary fails these tests, unless
 ``MYOSLICE_ALLOW_MISSING_CLI=1`` is set, which skips them. The speed comparison is
-sensitive to other load on the machine; ``MYOSLICE_TIMING_RUNS`` (default 3) sets how many
+sensitive to other load on the machine; ``MYOSLICE_TIMING_RUNS`` (default 9) sets how many
 interleaved runs it takes the best of.
 """
 
@@ -125,7 +125,12 @@ t0 = time.perf_counter()
 for _ in range(steps):
     step(dt)
 looped = time.perf_counter() - t0
-print(json.dumps({"batched_s": batched, "looped_s": looped, "knee_angle": sim.knee_angle}))
+angle = sim.knee_angle
+start()
+t0 = time.perf_counter()
+sim.step(dt * steps)
+single = time.perf_counter() - t0
+print(json.dumps({"batched_s": batched, "looped_s": looped, "single_s": single, "knee_angle": angle}))
 """
 
 
@@ -142,7 +147,7 @@ def python_timing(steps: int, dt: float, excite: dict[str, float], cwd: Path) ->
 def test_throughput_and_call_overhead(tmp_path: Path) -> None:
     steps, dt = 1000, 0.001
     # Interleaved, so that both see the same load on the machine.
-    rust_s, batched_s, looped_s = [], [], []
+    rust_s, batched_s, looped_s, single_s = [], [], [], []
     for _ in range(RUNS):
         report = probe(steps, dt, EXCITE)
         rust_s.append(float(report["wall_s"]))
@@ -151,7 +156,9 @@ def test_throughput_and_call_overhead(tmp_path: Path) -> None:
         assert timing["knee_angle"] == report["knee_angle"]
         batched_s.append(timing["batched_s"])
         looped_s.append(timing["looped_s"])
+        single_s.append(timing["single_s"])
     rust, python, loop = _best(rust_s), _best(batched_s), _best(looped_s)
+    single = _best(single_s)
     overhead_us = (loop - python) / steps * 1e6
 
     rows = [
@@ -159,6 +166,8 @@ def test_throughput_and_call_overhead(tmp_path: Path) -> None:
         (f"Python sim.step({dt}, n={steps})", python * 1e3, "ms"),
         (f"Python loop of {steps} sim.step({dt})", loop * 1e3, "ms"),
         ("overhead per Python step() call", overhead_us, "us"),
+        # One call for all the steps: one rollback copy instead of one per step.
+        (f"Python sim.step({dt * steps:g}), one call", single * 1e3, "ms"),
     ]
     summary = f"{steps} steps of {dt * 1e3:g} ms, rigid phantom, best of {RUNS}:\n" + "".join(
         f"  {label:<38}{value:9.2f} {unit}\n" for label, value, unit in rows
