@@ -34,15 +34,15 @@ pub(crate) struct BoneMesh {
 
 /// Where a walk over a bone surface ended.
 #[derive(Debug, Clone, Copy)]
-struct Walk {
+pub(crate) struct Walk {
     /// The nearest surface point it found.
-    point: Vec3,
+    pub(crate) point: Vec3,
     /// The triangle that point lies on.
-    triangle: u32,
+    pub(crate) triangle: u32,
     /// Whether the query point lies inside the bone (by the pseudo-normal there).
-    inside: bool,
+    pub(crate) inside: bool,
     /// Whether it stopped at a local minimum of the distance (else it ran out of steps).
-    settled: bool,
+    pub(crate) settled: bool,
 }
 
 /// Which part of a triangle a closest point lies on.
@@ -152,9 +152,14 @@ impl BoneMesh {
         }
     }
 
+    /// The body the bone moves with.
+    pub(crate) fn body(&self) -> BodyId {
+        self.body
+    }
+
     /// The nearest surface point to `p` (rest frame) found by walking from triangle
     /// `start` (see [`Walk`]).
-    fn walk(&self, start: u32, p: Vec3) -> Walk {
+    pub(crate) fn walk(&self, start: u32, p: Vec3) -> Walk {
         let mut cur = start.min(self.triangles.len().saturating_sub(1) as u32);
         let mut best = self.closest_on(cur, p);
         let mut d2 = best.0.distance_squared(p);

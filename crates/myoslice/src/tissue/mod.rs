@@ -2,6 +2,7 @@
 //! that follows muscles and bones, the knee fold and contact plane behind the knee, a
 //! validity guard, and the per-element metrics of the paper (section 5.3).
 
+mod bone_keep_out;
 mod bone_slide;
 mod fat_lanes;
 pub mod fat_solver;
@@ -28,6 +29,8 @@ use crate::body::{BodyId, KneeAxis, body_of_bone};
 use crate::error::{Result, check_range};
 use crate::lattice::{InnerContact, Lattice};
 use crate::muscle::{BodyFrames, MuscleUnit};
+pub use bone_keep_out::BoneOverlap;
+use bone_keep_out::Bones;
 use bone_slide::{BoneMesh, BoneSlide};
 use guard::Guard;
 
@@ -181,9 +184,14 @@ impl Tissue {
         config: TissueConfig,
     ) -> Result<Self> {
         config.validate()?;
+        let bone_meshes: Vec<BoneMesh> = bones.iter().map(|(b, m)| BoneMesh::new(*b, m)).collect();
         let shapes: Vec<MuscleShape> = muscles
             .par_iter()
-            .map(|m| MuscleShape::new(&lattice.muscles[m.lattice_index], &m.chain))
+            .map(|m| {
+                let mut s = MuscleShape::new(&lattice.muscles[m.lattice_index], &m.chain);
+                s.watch_bones(&bones, &bone_meshes, knee.point);
+                s
+            })
             .collect();
         let fat = &lattice.fat;
         let solver = FatSolver::new(&fat.vertices, &fat.hexes);
@@ -239,7 +247,7 @@ impl Tissue {
                 .collect(),
             guard_triangles,
             zone: FoldZone::new(&knee, &fat.vertices, &fat.hexes),
-            bone_meshes: bones.iter().map(|(b, m)| BoneMesh::new(*b, m)).collect(),
+            bone_meshes,
             bones: Arc::clone(&bones),
             outer_faces,
         };
@@ -271,6 +279,21 @@ impl Tissue {
         1.0 / self.config.rate_hz
     }
 
+    /// How far each muscle's surface reaches into bone with the bodies at `frames`, in
+    /// muscle order (exact, one tree query per muscle vertex near a bone: for checks,
+    /// not for every update).
+    pub fn muscles_in_bone(&self, frames: &BodyFrames) -> Vec<BoneOverlap> {
+        let bones = Bones {
+            meshes: &self.fixed.bone_meshes,
+            surfaces: &self.fixed.bones,
+            frames,
+        };
+        self.muscles
+            .par_iter()
+            .map(|m| bone_keep_out::overlap(&m.current, &bones))
+            .collect()
+    }
+
     /// Outer (skin) face of each outer-layer element, with its rest area (m²).
     pub fn outer_faces(&self) -> &[(u32, [u32; 4], f64)] {
         &self.fixed.outer_faces
@@ -291,7 +314,7 @@ impl Tissue {
             self.bone_slide.clone(),
             self.muscles
                 .iter()
-                .map(|m| (m.current.clone(), m.volume_now))
+                .map(|m| (m.current.clone(), m.volume_now, m.keep.shift.clone()))
                 .collect::<Vec<_>>(),
         );
         self.deform(knee_angle, frames, muscles);
@@ -306,8 +329,8 @@ impl Tissue {
             (self.fat.x, self.fat.rot, self.fat.free, self.fat.active) = (x, rot, free, active);
             (self.drift, self.theta, self.metrics) = (drift, theta, metrics);
             self.bone_slide = slide;
-            for (shape, (c, v)) in self.muscles.iter_mut().zip(current) {
-                (shape.current, shape.volume_now) = (c, v);
+            for (shape, (c, v, shift)) in self.muscles.iter_mut().zip(current) {
+                (shape.current, shape.volume_now, shape.keep.shift) = (c, v, shift);
             }
         }
         ok
@@ -328,7 +351,13 @@ impl Tissue {
             ..contact
         };
         // Muscles are not pushed by the contact plane: their volume is the invariant
-        // kept; the fat over them is.
+        // kept; the fat over them is. Bones push them aside, ring by ring.
+        let fixed = Arc::clone(&self.fixed);
+        let bones = Bones {
+            meshes: &fixed.bone_meshes,
+            surfaces: &fixed.bones,
+            frames,
+        };
         self.muscles
             .par_iter_mut()
             .zip(muscles)
@@ -343,10 +372,9 @@ impl Tissue {
                         };
                         shape.carry(q, t);
                     }
-                    _ => shape.update(&m.chain, &fold, None),
+                    _ => shape.update_clear_of(&m.chain, &fold, &bones),
                 }
             });
-        let fixed = Arc::clone(&self.fixed);
         let mut sc = std::mem::take(&mut self.scratch);
         // The fold of the rest shape is valid: the fallback of the guard below.
         knee_fold::fold_hexes(

@@ -5,13 +5,18 @@
 
 use glam::{Mat3, Quat, Vec3, Vec3A};
 
+use super::bone_keep_out::{BoneKeepOut, Bones};
 use super::knee_fold::{Contact, KneeFold};
 use crate::lattice::{MuscleLattice, signed_volume};
 use crate::muscle::MuscleChain;
 
-/// Placement passes per update: each after the first corrects the cross-sections by the
-/// volume the previous one missed.
-const VOLUME_PASSES: usize = 5;
+/// Most placement passes per update: each after the first corrects the cross-sections by
+/// the volume the previous one missed. Most updates need two; a small muscle whose rings
+/// were shifted far out of bone (plantaris by the condyle) needed more than five.
+const VOLUME_PASSES: usize = 12;
+
+/// Most rounds of shifting rings out of bone per update.
+const PUSH_ROUNDS: usize = 8;
 
 /// Where a ring rides on the chain and how its vertices sit around it.
 #[derive(Debug, Clone)]
@@ -37,6 +42,8 @@ pub struct MuscleShape {
     pub volume_now: f64,
     /// Surface triangles (from the lattice).
     pub triangles: Vec<[u32; 3]>,
+    /// The rings' shifts out of bone.
+    pub(crate) keep: BoneKeepOut,
 }
 
 /// Closest point to `q` on the segments of polyline `p` that `allowed` admits.
@@ -105,7 +112,19 @@ impl MuscleShape {
             rest_volume: mesh.volume().abs(),
             volume_now: mesh.volume().abs(),
             triangles: mesh.triangles.clone(),
+            keep: BoneKeepOut::default(),
         }
+    }
+
+    /// Watches the vertices near `bones` at rest (more of them near the knee point
+    /// `knee`), to keep them out of those bones.
+    pub(crate) fn watch_bones(
+        &mut self,
+        bones: &[(crate::body::BodyId, parry3d::shape::TriMesh)],
+        meshes: &[super::bone_slide::BoneMesh],
+        knee: Vec3,
+    ) {
+        self.keep = BoneKeepOut::new(&self.rest, self.ring_param.len(), bones, meshes, knee);
     }
 
     /// Places every vertex on the chain's current shape. Where the knee fold rules (see
@@ -115,6 +134,21 @@ impl MuscleShape {
     /// `contact` keeps thigh-side and calf-side vertices apart behind the knee (see
     /// [`Contact`]); the cross-sections then make up the volume it squeezed out.
     pub fn update(&mut self, chain: &MuscleChain, knee: &KneeFold, contact: Option<&Contact>) {
+        self.place(chain, knee, contact, None);
+    }
+
+    /// [`Self::update`], with the rings shifted out of the bones where they reach in.
+    pub(crate) fn update_clear_of(&mut self, chain: &MuscleChain, knee: &KneeFold, bones: &Bones) {
+        self.place(chain, knee, None, Some(bones));
+    }
+
+    fn place(
+        &mut self,
+        chain: &MuscleChain,
+        knee: &KneeFold,
+        contact: Option<&Contact>,
+        bones: Option<&Bones>,
+    ) {
         let segs = self.rest_chain.len() - 1;
         let mut seg_rot = Vec::with_capacity(segs);
         let mut seg_len = Vec::with_capacity(segs);
@@ -141,10 +175,15 @@ impl MuscleShape {
         };
         // Per ring: centre, turn (as a matrix: one per ring, not per vertex) and stretch
         // (all its vertices share them).
-        let rings: Vec<(Vec3, Mat3, Vec3, f32)> = self
+        if bones.is_some() {
+            self.keep.fade();
+        }
+        let shift = &self.keep.shift;
+        let mut rings: Vec<(Vec3, Mat3, Vec3, f32)> = self
             .ring_param
             .iter()
-            .map(|&(s, t)| {
+            .enumerate()
+            .map(|(r, &(s, t))| {
                 let s = s as usize;
                 let ((q0, l0), (q1, l1)) = (point(s), point(s + 1));
                 let mut q = q0.slerp(q1, t);
@@ -154,7 +193,8 @@ impl MuscleShape {
                 if near > 0.0 {
                     q = q.slerp(knee.rotation(centre_rest), near);
                 }
-                let c = chain.x[s].lerp(chain.x[s + 1], t);
+                let c =
+                    chain.x[s].lerp(chain.x[s + 1], t) + shift.get(r).copied().unwrap_or_default();
                 (c, Mat3::from_quat(q), q * seg_len[s].1, lambda)
             })
             .collect();
@@ -171,6 +211,25 @@ impl MuscleShape {
             if let Some(c) = contact {
                 for (p, r) in self.current.iter_mut().zip(&self.rest) {
                     *p = c.apply(*p, r.z >= knee.point.z, c.muscle_margin);
+                }
+            }
+            // In the first pass only: the volume passes change the cross-sections by far
+            // less than the margin the shifted rings keep. A shift can move a ring's
+            // other vertices in, so a few rounds.
+            if pass == 0
+                && let Some(b) = bones
+            {
+                for _ in 0..PUSH_ROUNDS {
+                    let axis = |r: usize| rings[r].2;
+                    if !self
+                        .keep
+                        .push_out(&mut self.current, &self.ring_of, axis, b)
+                    {
+                        break;
+                    }
+                    for (ring, s) in rings.iter_mut().zip(&self.keep.spread) {
+                        ring.0 += *s;
+                    }
                 }
             }
             // What the piecewise map still gains or loses, the cross-sections give back:
@@ -191,6 +250,7 @@ impl MuscleShape {
         for (p, r) in self.current.iter_mut().zip(&self.rest) {
             *p = m * *r + t;
         }
+        self.keep.clear();
         self.volume_now = self.rest_volume;
     }
 

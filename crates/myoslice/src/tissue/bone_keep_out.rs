@@ -1,0 +1,260 @@
+//! Muscle surfaces kept out of bone. A cross-section ring that a bone reaches into is
+//! shifted out whole, across its muscle until clear of the bone, rather than squashed:
+//! a shifted ring keeps its area, so the muscle keeps its volume (squashing the vertices
+//! onto the bone took up to 61 % of a small muscle pressed between two bones). The shift
+//! stays with the ring from update to update and fades once the bone has gone.
+
+use glam::{Quat, Vec3};
+use parry3d::bounding_volume::BoundingVolume;
+use parry3d::query::PointQueryWithLocation;
+use parry3d::shape::TriMesh;
+
+use super::bone_slide::BoneMesh;
+use crate::body::BodyId;
+use crate::muscle::BodyFrames;
+
+/// Muscle vertices closer than this (m) to a bone at rest are watched against it...
+const NEAR_M: f32 = 0.02;
+/// ...and within [`KNEE_M`] of the knee, where the bones turn past each other, this.
+const NEAR_KNEE_M: f32 = 0.06;
+/// Distance (m) from the knee point within which [`NEAR_KNEE_M`] holds.
+const KNEE_M: f32 = 0.12;
+/// How far (m) beyond the bone surface a pushed ring ends up.
+const MARGIN_M: f32 = 0.001;
+/// Share of a ring's shift given to its neighbours 1, 2, 3... rings away (the surface
+/// bends over several rings rather than stepping: a step creased the skin over it).
+const SPREAD: [f32; 3] = [0.75, 0.5, 0.25];
+/// Share of a ring's shift kept from one update to the next.
+const FADE: f32 = 0.9;
+
+/// The bones a tissue update sees: surfaces with adjacency, the same as parry meshes (for
+/// the rare global query) and the bodies' poses.
+#[derive(Clone, Copy)]
+pub(crate) struct Bones<'a> {
+    pub(crate) meshes: &'a [BoneMesh],
+    pub(crate) surfaces: &'a [(BodyId, TriMesh)],
+    pub(crate) frames: &'a BodyFrames,
+}
+
+impl Bones<'_> {
+    fn pose(&self, body: BodyId) -> (Quat, Vec3) {
+        match body {
+            BodyId::Thigh => self.frames.thigh,
+            BodyId::Shank => self.frames.shank,
+        }
+    }
+
+    /// How far `p` (world) lies inside bone `b`, as the world vector that takes it to the
+    /// surface; None when outside. `w` is what the pair knew at its last check.
+    fn depth(&self, b: usize, p: Vec3, w: &mut Watch) -> Option<Vec3> {
+        let mesh = &self.meshes[b];
+        let (q, t) = self.pose(mesh.body());
+        let p_rest = q.inverse() * (p - t);
+        // Still within the ball that was clear of the bone at the last check: outside.
+        if p_rest.distance_squared(w.from) < w.clear * w.clear {
+            return None;
+        }
+        let mut walk = mesh.walk(w.nearest, p_rest);
+        if walk.inside || !walk.settled {
+            // A walk may stop at a nearest point that is only local: ask the tree before
+            // moving anything (as the fat's bone sliding does).
+            let (_, (tri, _)) = self.surfaces[b]
+                .1
+                .project_local_point_and_get_location(p_rest, false);
+            walk = mesh.walk(tri, p_rest);
+        }
+        w.nearest = walk.triangle;
+        if walk.inside {
+            w.clear = 0.0;
+            return Some(q * (walk.point - p_rest));
+        }
+        w.from = p_rest;
+        w.clear = walk.point.distance(p_rest);
+        None
+    }
+}
+
+/// What a watched pair knew at its last check.
+#[derive(Debug, Clone, Copy)]
+struct Watch {
+    /// The triangle the vertex was nearest (where the next walk starts).
+    nearest: u32,
+    /// Where the vertex was (bone rest frame)...
+    from: Vec3,
+    /// ...and how far from the bone (m): until it has moved that far it cannot be in.
+    clear: f32,
+}
+
+/// Which muscle vertices are watched against which bone, and each ring's shift.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct BoneKeepOut {
+    /// (muscle vertex, bone index) pairs near enough at rest to meet.
+    pairs: Vec<(u32, u32)>,
+    /// What each pair knew at its last check.
+    watch: Vec<Watch>,
+    /// Shift of each ring (world, m).
+    pub(crate) shift: Vec<Vec3>,
+    /// Work buffers: the shift each ring needs this update, and that spread to its
+    /// neighbours.
+    need: Vec<Vec3>,
+    pub(crate) spread: Vec<Vec3>,
+}
+
+impl BoneKeepOut {
+    /// Pairs every vertex of `rest` with each bone within [`NEAR_M`] of it
+    /// ([`NEAR_KNEE_M`] near the knee point `knee`). A vertex already inside a bone at
+    /// rest (where the slices let muscle and bone overlap) is left alone: no shift of a
+    /// ring wrapped round a bone frees it.
+    pub(crate) fn new(
+        rest: &[Vec3],
+        rings: usize,
+        bones: &[(BodyId, TriMesh)],
+        meshes: &[BoneMesh],
+        knee: Vec3,
+    ) -> Self {
+        let mut pairs = Vec::new();
+        let mut watch = Vec::new();
+        for (b, (_, mesh)) in bones.iter().enumerate() {
+            let (aabb, aabb_knee) = (
+                mesh.local_aabb().loosened(NEAR_M),
+                mesh.local_aabb().loosened(NEAR_KNEE_M),
+            );
+            for (v, &p) in rest.iter().enumerate() {
+                let (near, bounds) = if p.distance(knee) < KNEE_M {
+                    (NEAR_KNEE_M, &aabb_knee)
+                } else {
+                    (NEAR_M, &aabb)
+                };
+                if !bounds.contains_local_point(p) {
+                    continue;
+                }
+                // The tree search gives up beyond `near`: most vertices are far.
+                let Some((proj, (tri, _))) =
+                    mesh.project_local_point_and_get_location_with_max_dist(p, false, near)
+                else {
+                    continue;
+                };
+                let clear = proj.point.distance(p);
+                if clear < near && !meshes[b].walk(tri, p).inside {
+                    pairs.push((v as u32, b as u32));
+                    watch.push(Watch {
+                        nearest: tri,
+                        from: p,
+                        clear,
+                    });
+                }
+            }
+        }
+        Self {
+            pairs,
+            watch,
+            shift: vec![Vec3::ZERO; rings],
+            need: vec![Vec3::ZERO; rings],
+            spread: vec![Vec3::ZERO; rings],
+        }
+    }
+
+    /// Lets the shifts fade (a bone that has left no longer holds the rings off).
+    pub(crate) fn fade(&mut self) {
+        self.shift.iter_mut().for_each(|s| *s *= FADE);
+    }
+
+    /// Forgets every shift (the shape is back at rest on one body).
+    pub(crate) fn clear(&mut self) {
+        self.shift.iter_mut().for_each(|s| *s = Vec3::ZERO);
+    }
+
+    /// Finds the rings a bone reaches into, shifts them out (their neighbours half as
+    /// far, so the surface bends rather than steps) and moves their vertices in
+    /// `current` with them. Returns whether anything moved.
+    ///
+    /// A ring moves across its muscle only (`axis` gives each ring's direction): moved
+    /// along, it would slide into its neighbours and crease the surface.
+    pub(crate) fn push_out(
+        &mut self,
+        current: &mut [Vec3],
+        ring_of: &[u32],
+        axis: impl Fn(usize) -> Vec3,
+        bones: &Bones,
+    ) -> bool {
+        self.need.iter_mut().for_each(|n| *n = Vec3::ZERO);
+        let mut any = false;
+        for (&(v, b), w) in self.pairs.iter().zip(&mut self.watch) {
+            let Some(d) = bones.depth(b as usize, current[v as usize], w) else {
+                continue;
+            };
+            let r = ring_of[v as usize] as usize;
+            let push = d + d.normalize_or_zero() * MARGIN_M;
+            // Across the ring, as far as clears the bone along its normal (at most twice
+            // the depth where the normal runs nearly along the muscle).
+            let a = axis(r);
+            let across = push - a * push.dot(a);
+            let clears = across.dot(push);
+            let push = if clears > 0.25 * push.length_squared() {
+                across * (push.length_squared() / clears)
+            } else {
+                across.normalize_or_zero() * (2.0 * push.length())
+            };
+            let need = &mut self.need[r];
+            if push.length_squared() > need.length_squared() {
+                *need = push;
+            }
+            any = true;
+        }
+        if !any {
+            return false;
+        }
+        let rings = self.need.len();
+        for r in 0..rings {
+            let mut total = self.need[r];
+            for (k, w) in SPREAD.iter().enumerate() {
+                for nb in [r.wrapping_sub(k + 1), r + k + 1] {
+                    if let Some(&m) = self.need.get(nb) {
+                        let part = m * *w;
+                        if part.length_squared() > total.length_squared() {
+                            total = part;
+                        }
+                    }
+                }
+            }
+            self.spread[r] = total;
+            self.shift[r] += total;
+        }
+        for (p, &r) in current.iter_mut().zip(ring_of) {
+            *p += self.spread[r as usize];
+        }
+        true
+    }
+}
+
+/// How far muscle surfaces reach into bone (see [`super::Tissue::muscles_in_bone`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BoneOverlap {
+    /// Muscle vertices more than 1 mm inside a bone.
+    pub vertices_over_1mm: usize,
+    /// Deepest muscle vertex inside a bone (m), 0 when none is.
+    pub deepest_m: f32,
+}
+
+/// Measures `vertices` against every bone (exact: a tree query per vertex near a bone).
+pub(crate) fn overlap(vertices: &[Vec3], bones: &Bones) -> BoneOverlap {
+    let mut o = BoneOverlap::default();
+    for (b, (body, mesh)) in bones.surfaces.iter().enumerate() {
+        let (q, t) = bones.pose(*body);
+        let aabb = mesh.local_aabb();
+        for &p in vertices {
+            let p_rest = q.inverse() * (p - t);
+            if !aabb.contains_local_point(p_rest) {
+                continue;
+            }
+            let (_, (tri, _)) = mesh.project_local_point_and_get_location(p_rest, false);
+            let w = bones.meshes[b].walk(tri, p_rest);
+            if w.inside {
+                let d = w.point.distance(p_rest);
+                o.deepest_m = o.deepest_m.max(d);
+                o.vertices_over_1mm += usize::from(d > 1e-3);
+            }
+        }
+    }
+    o
+}
