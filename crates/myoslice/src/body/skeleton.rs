@@ -105,7 +105,7 @@ impl Clone for Skeleton {
 #[derive(Debug, Clone, Copy)]
 pub struct SkeletonSnapshot {
     joint: Option<MultibodyJoint>,
-    velocities: [f32; 6],
+    velocities: [f32; 12],
     linvel: Vec3,
     angvel: Vec3,
 }
@@ -274,12 +274,16 @@ impl Skeleton {
 
     /// The moving state now (see [`SkeletonSnapshot`]).
     pub fn snapshot(&self) -> SkeletonSnapshot {
-        let mut velocities = [0.0; 6];
+        let mut velocities = [0.0; 12];
         let mut joint = None;
         if let Some(link) = self.multibody.rigid_body_link(self.shank).copied()
             && let Some(mb) = self.multibody.get_multibody(link.multibody)
         {
             joint = mb.link(link.id).map(|l| l.joint);
+            debug_assert!(
+                mb.ndofs() <= velocities.len(),
+                "a multibody of at most 12 dofs"
+            );
             for (v, &g) in velocities.iter_mut().zip(mb.generalized_velocity().iter()) {
                 *v = g;
             }
@@ -312,8 +316,8 @@ impl Skeleton {
             mb.update_rigid_bodies(&mut self.bodies, true);
         }
         if let Some(b) = self.bodies.get_mut(self.shank) {
-            // Rapier disables a body whose pose went non-finite; the simulation refuses
-            // forces that could do that, and this only keeps a stray case usable.
+            // Rapier disables a body whose pose went non-finite (the step reports it);
+            // the snapshot's state is finite, so the body can move again.
             if !b.is_enabled() {
                 b.set_enabled(true);
             }
@@ -359,8 +363,9 @@ impl Skeleton {
     }
 
     /// Advances by `dt` with `forces` (world force, world application point) acting on
-    /// the shank.
-    pub fn step(&mut self, dt: f64, forces: &[(Vec3, Vec3)]) {
+    /// the shank. Returns false if rapier had to stop a body whose pose went non-finite
+    /// (it puts the body back and freezes it: the step did not happen as asked).
+    pub fn step(&mut self, dt: f64, forces: &[(Vec3, Vec3)]) -> bool {
         if let Some(b) = self.bodies.get_mut(self.shank) {
             b.reset_forces(true);
             b.reset_torques(true);
@@ -384,6 +389,7 @@ impl Skeleton {
             &(),
             &(),
         );
+        self.pipeline.quarantine().is_empty()
     }
 
     /// Velocity (world, m/s) of the shank material point now at world position `p`.

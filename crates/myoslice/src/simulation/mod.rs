@@ -498,8 +498,9 @@ impl Simulation {
     }
 
     /// Advances the simulation by `dt` seconds (split into steps of at most
-    /// `max_step_s`). If anything becomes non-finite, the state before the call is kept
-    /// and an error says what failed.
+    /// `max_step_s`). If anything becomes non-finite, the muscles and the skeleton go
+    /// back to their state before the call, the tissue keeps its last good shape, and an
+    /// error says what failed.
     pub fn step(&mut self, dt: f64) -> Result<()> {
         check_positive("dt", dt)?;
         if dt > 10.0 {
@@ -647,11 +648,14 @@ impl Simulation {
             .iter()
             .find(|(f, at)| !(f.length() <= MAX_BODY_FORCE_N && at.is_finite()));
         if let Some(&(f, _)) = unbounded {
-            let what = format!("a muscle force of {} N on the shank", f.length());
+            let what = format!("an unbounded muscle force of {} N on the shank", f.length());
             self.scratch = (forces, loads);
             return Some(what);
         }
-        self.skeleton.step(h, &forces);
+        if !self.skeleton.step(h, &forces) {
+            self.scratch = (forces, loads);
+            return Some("the shank's pose (rapier stopped it)".into());
+        }
         let next = self.current_frames();
         // The thigh is fixed: the shank turns about the knee axis, so the path lengthens at
         // −(moment arm) × knee velocity (virtual work).

@@ -19,12 +19,15 @@ const NEAR_M: f32 = 0.02;
 const NEAR_KNEE_M: f32 = 0.06;
 /// Distance (m) from the knee point within which [`NEAR_KNEE_M`] holds.
 const KNEE_M: f32 = 0.12;
+/// Beyond this distance (m) from the bone a vertex's clear ball is renewed from the tree.
+const TREE_REFRESH_M: f32 = 0.004;
 /// How far (m) beyond the bone surface a pushed ring ends up.
 const MARGIN_M: f32 = 0.001;
 /// Share of a ring's shift given to its neighbours 1, 2, 3... rings away (the surface
 /// bends over several rings rather than stepping: a step creased the skin over it).
 const SPREAD: [f32; 3] = [0.75, 0.5, 0.25];
-/// Share of a ring's shift kept from one update to the next.
+/// Share of a ring's shift kept over a thirtieth of a second (one update at the default
+/// rate).
 const FADE: f32 = 0.9;
 
 /// The bones a tissue update sees: surfaces with adjacency, the same as parry meshes (for
@@ -34,6 +37,14 @@ pub(crate) struct Bones<'a> {
     pub(crate) meshes: &'a [BoneMesh],
     pub(crate) surfaces: &'a [(BodyId, TriMesh)],
     pub(crate) frames: &'a BodyFrames,
+    /// Share of a ring's shift kept into this update (see [`fade_per_update`]).
+    pub(crate) fade: f32,
+}
+
+/// Share of a ring's shift kept from one update to the next at `rate_hz` updates a second:
+/// [`FADE`] per thirtieth of a second whatever the rate.
+pub(crate) fn fade_per_update(rate_hz: f64) -> f32 {
+    FADE.powf((30.0 / rate_hz.max(1e-3)) as f32)
 }
 
 impl Bones<'_> {
@@ -68,8 +79,35 @@ impl Bones<'_> {
             w.clear = 0.0;
             return Some(q * (walk.point - p_rest));
         }
+        // The walk's nearest point may be only local, so it cannot vouch for a ball. Close
+        // to the bone the ball known before shrinks by how far the vertex has gone (a
+        // walk an update costs little there); further out the tree, searched no further
+        // than the walk's distance, gives a ball that lasts many updates.
+        let d = walk.point.distance(p_rest);
+        let shrunk = (w.clear - p_rest.distance(w.from)).max(0.0);
+        w.clear = shrunk;
+        if d > TREE_REFRESH_M {
+            match self.surfaces[b]
+                .1
+                .project_local_point_and_get_location_with_max_dist(p_rest, false, d)
+            {
+                Some((proj, (tri, _))) => {
+                    let exact = mesh.walk(tri, p_rest);
+                    w.nearest = exact.triangle;
+                    if exact.inside {
+                        w.clear = 0.0;
+                        return Some(q * (exact.point - p_rest));
+                    }
+                    w.clear = exact
+                        .point
+                        .distance(p_rest)
+                        .min(proj.point.distance(p_rest));
+                }
+                // Nothing nearer than the walk's point: it is the nearest.
+                None => w.clear = d,
+            }
+        }
         w.from = p_rest;
-        w.clear = walk.point.distance(p_rest);
         None
     }
 }
@@ -154,9 +192,9 @@ impl BoneKeepOut {
         }
     }
 
-    /// Lets the shifts fade (a bone that has left no longer holds the rings off).
-    pub(crate) fn fade(&mut self) {
-        self.shift.iter_mut().for_each(|s| *s *= FADE);
+    /// Lets the shifts fade by `keep` (a bone that has left no longer holds the rings off).
+    pub(crate) fn fade(&mut self, keep: f32) {
+        self.shift.iter_mut().for_each(|s| *s *= keep);
     }
 
     /// Forgets every shift (the shape is back at rest on one body).
@@ -164,9 +202,10 @@ impl BoneKeepOut {
         self.shift.iter_mut().for_each(|s| *s = Vec3::ZERO);
     }
 
-    /// Finds the rings a bone reaches into, shifts them out (their neighbours half as
-    /// far, so the surface bends rather than steps) and moves their vertices in
-    /// `current` with them. Returns whether anything moved.
+    /// Finds the rings a bone reaches into, shifts them out (a neighbour as far as the
+    /// largest of [`SPREAD`]'s shares of the rings near it, so the surface bends rather
+    /// than steps) and moves their vertices in `current` with them. Returns whether
+    /// anything moved.
     ///
     /// A ring moves across its muscle only (`axis` gives each ring's direction): moved
     /// along, it would slide into its neighbours and crease the surface.
@@ -195,6 +234,9 @@ impl BoneKeepOut {
             } else {
                 across.normalize_or_zero() * (2.0 * push.length())
             };
+            if push == Vec3::ZERO {
+                continue; // the bone's normal runs along the muscle: nothing across
+            }
             let need = &mut self.need[r];
             if push.length_squared() > need.length_squared() {
                 *need = push;

@@ -287,6 +287,7 @@ impl Tissue {
             meshes: &self.fixed.bone_meshes,
             surfaces: &self.fixed.bones,
             frames,
+            fade: 1.0,
         };
         self.muscles
             .par_iter()
@@ -357,6 +358,7 @@ impl Tissue {
             meshes: &fixed.bone_meshes,
             surfaces: &fixed.bones,
             frames,
+            fade: bone_keep_out::fade_per_update(self.config.rate_hz),
         };
         self.muscles
             .par_iter_mut()

@@ -175,10 +175,15 @@ impl MuscleShape {
         };
         // Per ring: centre, turn (as a matrix: one per ring, not per vertex) and stretch
         // (all its vertices share them).
-        if bones.is_some() {
-            self.keep.fade();
-        }
-        let shift = &self.keep.shift;
+        // Shifts out of bone only where bones are watched; kept across the muscle (the
+        // rings turn with it while a shift is world-fixed).
+        let shift: &[Vec3] = match bones {
+            Some(b) => {
+                self.keep.fade(b.fade);
+                &self.keep.shift
+            }
+            None => &[],
+        };
         let mut rings: Vec<(Vec3, Mat3, Vec3, f32)> = self
             .ring_param
             .iter()
@@ -193,9 +198,10 @@ impl MuscleShape {
                 if near > 0.0 {
                     q = q.slerp(knee.rotation(centre_rest), near);
                 }
-                let c =
-                    chain.x[s].lerp(chain.x[s + 1], t) + shift.get(r).copied().unwrap_or_default();
-                (c, Mat3::from_quat(q), q * seg_len[s].1, lambda)
+                let axis = q * seg_len[s].1;
+                let sh = shift.get(r).copied().unwrap_or_default();
+                let c = chain.x[s].lerp(chain.x[s + 1], t) + (sh - axis * sh.dot(axis));
+                (c, Mat3::from_quat(q), axis, lambda)
             })
             .collect();
         // Volumes are taken about a point inside the muscle: small coordinates keep the
