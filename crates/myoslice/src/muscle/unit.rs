@@ -77,15 +77,15 @@ pub struct MuscleUnit {
 
 impl Clone for MuscleUnit {
     fn clone(&self) -> Self {
-        let mut u = Self {
-            name: String::new(),
+        Self {
+            name: self.name.clone(),
             lattice_index: self.lattice_index,
             group: self.group,
             hill: self.hill,
             chain: self.chain.clone(),
             crosses_knee: self.crosses_knee,
             mass: self.mass,
-            bones: Default::default(),
+            bones: self.bones.clone(),
             from_catalogue: self.from_catalogue,
             excitation: self.excitation,
             activation: self.activation,
@@ -95,9 +95,7 @@ impl Clone for MuscleUnit {
             fibre: self.fibre,
             moment_arm: self.moment_arm,
             current_moment_arm: self.current_moment_arm,
-        };
-        u.clone_from(self);
-        u
+        }
     }
 
     /// Copies into the buffers already here (see [`MuscleChain`]'s `clone_from`).

@@ -65,15 +65,7 @@ impl Bones<'_> {
         if p_rest.distance_squared(w.from) < w.clear * w.clear {
             return None;
         }
-        let mut walk = mesh.walk(w.nearest, p_rest);
-        if walk.inside || !walk.settled {
-            // A walk may stop at a nearest point that is only local: ask the tree before
-            // moving anything (as the fat's bone sliding does).
-            let (_, (tri, _)) = self.surfaces[b]
-                .1
-                .project_local_point_and_get_location(p_rest, false);
-            walk = mesh.walk(tri, p_rest);
-        }
+        let walk = mesh.walk_checked(w.nearest, p_rest, &self.surfaces[b].1);
         w.nearest = walk.triangle;
         if walk.inside {
             w.clear = 0.0;
@@ -289,8 +281,7 @@ pub(crate) fn overlap(vertices: &[Vec3], bones: &Bones) -> BoneOverlap {
             if !aabb.contains_local_point(p_rest) {
                 continue;
             }
-            let (_, (tri, _)) = mesh.project_local_point_and_get_location(p_rest, false);
-            let w = bones.meshes[b].walk(tri, p_rest);
+            let w = bones.meshes[b].walk_from_tree(mesh, p_rest);
             if w.inside {
                 let d = w.point.distance(p_rest);
                 o.deepest_m = o.deepest_m.max(d);

@@ -108,23 +108,8 @@ impl BoneMesh {
                 (edge_normals[t0][k0], edge_normals[t1][k1]) = (sum, sum);
             }
         }
-        let mut fan_start = vec![0u32; vertices.len() + 1];
-        for t in &triangles {
-            for &v in t {
-                fan_start[v as usize + 1] += 1;
-            }
-        }
-        for v in 0..vertices.len() {
-            fan_start[v + 1] += fan_start[v];
-        }
-        let mut fill = fan_start.clone();
-        let mut fan = vec![0u32; triangles.len() * 3];
-        for (ti, t) in triangles.iter().enumerate() {
-            for &v in t {
-                fan[fill[v as usize] as usize] = ti as u32;
-                fill[v as usize] += 1;
-            }
-        }
+        let (fan_start, corners) = super::incidence::vertex_corners(vertices.len(), &triangles);
+        let fan = corners.into_iter().map(|c| c / 3).collect();
         Self {
             body,
             vertices,
@@ -198,6 +183,25 @@ impl BoneMesh {
             triangle: cur,
             inside: (p - best.0).dot(self.pseudo_normal(cur, best.1)) < 0.0,
             settled,
+        }
+    }
+
+    /// The nearest surface point to `p` (rest frame) from the tree's nearest triangle
+    /// (exact, a tree search).
+    pub(crate) fn walk_from_tree(&self, tree: &TriMesh, p: Vec3) -> Walk {
+        let (_, (tri, _)) = tree.project_local_point_and_get_location(p, false);
+        self.walk(tri, p)
+    }
+
+    /// [`Self::walk`] from `start`; but a walk can stop at a nearest point that is only
+    /// local (across a concave part of the bone): when it says inside, or runs out of
+    /// steps, the tree (`tree`, this bone's parry mesh) decides before anything moves.
+    pub(crate) fn walk_checked(&self, start: u32, p: Vec3, tree: &TriMesh) -> Walk {
+        let w = self.walk(start, p);
+        if w.inside || !w.settled {
+            self.walk_from_tree(tree, p)
+        } else {
+            w
         }
     }
 }
@@ -282,16 +286,7 @@ impl BoneSlide {
             let mesh = &meshes[b as usize];
             let (q, t) = pose(mesh.body);
             let p_rest = q.inverse() * (x[v as usize] - t);
-            let mut w = mesh.walk(self.nearest[k], p_rest);
-            if w.inside || !w.settled {
-                // A walk can stop at a nearest point that is only local (across a
-                // concave part of the bone): before pulling a vertex through to the
-                // other side, or when the walk ran out of steps, ask the tree.
-                let (_, (tri, _)) = surfaces[b as usize]
-                    .1
-                    .project_local_point_and_get_location(p_rest, false);
-                w = mesh.walk(tri, p_rest);
-            }
+            let w = mesh.walk_checked(self.nearest[k], p_rest, &surfaces[b as usize].1);
             self.nearest[k] = w.triangle;
             let out = if w.inside {
                 (w.point - p_rest).normalize_or_zero()

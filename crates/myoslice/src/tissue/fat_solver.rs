@@ -97,23 +97,7 @@ impl FatSolver {
     /// A solver at rest for a lattice.
     pub fn new(rest: &[Vec3], hexes: &[[u32; 8]]) -> Self {
         let rel: Vec<[Vec3; 8]> = hexes.iter().map(|h| relative_corners(rest, h)).collect();
-        let mut count = vec![0u32; rest.len() + 1];
-        for h in hexes {
-            for &v in h {
-                count[v as usize + 1] += 1;
-            }
-        }
-        for i in 0..rest.len() {
-            count[i + 1] += count[i];
-        }
-        let mut fill = count.clone();
-        let mut inc = vec![0u32; hexes.len() * 8];
-        for (e, h) in hexes.iter().enumerate() {
-            for (k, &v) in h.iter().enumerate() {
-                inc[fill[v as usize] as usize] = (e * 8 + k) as u32;
-                fill[v as usize] += 1;
-            }
-        }
+        let (count, inc) = super::incidence::vertex_corners(rest.len(), hexes);
         let rest_volume = hexes
             .iter()
             .map(|h| crate::lattice::hex_volume_points(&h.map(|i| rest[i as usize].as_dvec3())))

@@ -7,6 +7,7 @@ mod bone_slide;
 mod fat_lanes;
 pub mod fat_solver;
 mod guard;
+mod incidence;
 pub mod intersect;
 pub mod knee_fold;
 pub mod metrics;
