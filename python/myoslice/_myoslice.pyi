@@ -75,6 +75,16 @@ class Simulation:
     def step(self, dt: float = 0.001, n: int = 1) -> None:
         """Advances ``n`` steps of ``dt`` seconds (the GIL is released meanwhile)."""
 
+    @property
+    def timers(self) -> dict[str, float | int | None]:
+        """Wall-clock time spent in :meth:`step` on the Rust side since the build or
+        :meth:`reset_timers`: ``calls``, ``steps``, ``tissue_updates`` (counts),
+        ``simulated_s``, ``wall_s``, ``tissue_wall_s``, ``muscles_wall_s`` (seconds) and
+        ``realtime_factor`` (None before any step)."""
+
+    def reset_timers(self) -> None:
+        """Starts the step timers from zero."""
+
     def set_excitation(self, name: str, value: float) -> None:
         """Sets one muscle's excitation in [0, 1]."""
 

@@ -1,81 +1,23 @@
 //! Python bindings of myoslice: `myoslice._myoslice`. Thin: every behaviour lives in the
 //! core crate; this file converts arguments, arrays and errors.
 
-use std::path::{Path, PathBuf};
+mod arrays;
+mod errors;
+
+use std::path::PathBuf;
 use std::sync::OnceLock;
 
-use glam::Vec3;
 use myoslice::muscle::MuscleCatalogue;
 use myoslice::prelude::*;
 use myoslice::simulation::{Layer, SimulationState};
-use myoslice::tissue::TissueMetrics;
 use myoslice_viewer::capture::{CaptureOptions, Offscreen};
 use myoslice_viewer::{CameraPreset, ColorMode, Gpu};
-use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray1, PyArray3, PyReadonlyArray1};
 use pyo3::prelude::*;
-use pyo3::sync::PyOnceLock;
-use pyo3::types::{PyDict, PyType};
+use pyo3::types::PyDict;
 
-/// Vertices (float32, (N, 3)) and triangles (uint32, (M, 3)) of a surface.
-type SurfaceArrays<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<u32>>);
-
-/// The Python exception classes of `myoslice.errors`.
-#[derive(Clone, Copy)]
-enum Kind {
-    Invalid,
-    UnknownName,
-    File,
-    Simulation,
-    Renderer,
-}
-
-fn py_err(py: Python<'_>, kind: Kind, msg: String) -> PyErr {
-    static CLASSES: [PyOnceLock<Py<PyType>>; 5] = [
-        PyOnceLock::new(),
-        PyOnceLock::new(),
-        PyOnceLock::new(),
-        PyOnceLock::new(),
-        PyOnceLock::new(),
-    ];
-    let (i, name) = match kind {
-        Kind::Invalid => (0, "InvalidInputError"),
-        Kind::UnknownName => (1, "UnknownNameError"),
-        Kind::File => (2, "ModelFileError"),
-        Kind::Simulation => (3, "SimulationError"),
-        Kind::Renderer => (4, "RendererUnavailableError"),
-    };
-    match CLASSES[i].import(py, "myoslice.errors", name) {
-        Ok(ty) => PyErr::from_type(ty.clone(), msg),
-        Err(e) => e,
-    }
-}
-
-fn core_err(py: Python<'_>, e: myoslice::Error) -> PyErr {
-    use myoslice::Error as E;
-    let kind = match &e {
-        E::Io { .. }
-        | E::Write { .. }
-        | E::Nifti { .. }
-        | E::Png { .. }
-        | E::Parse { .. }
-        | E::UnknownLabel { .. } => Kind::File,
-        E::UnknownName { .. } => Kind::UnknownName,
-        E::NonFinite { .. } => Kind::Simulation,
-        _ => Kind::Invalid,
-    };
-    py_err(py, kind, e.to_string())
-}
-
-trait OrPy<T> {
-    fn or_py(self, py: Python<'_>) -> PyResult<T>;
-}
-
-impl<T> OrPy<T> for Result<T, myoslice::Error> {
-    fn or_py(self, py: Python<'_>) -> PyResult<T> {
-        self.map_err(|e| core_err(py, e))
-    }
-}
+use arrays::{SurfaceArrays, check_path, metric_array, tri_array, vec3_array};
+use errors::{Kind, OrPy, py_err};
 
 /// A checkpoint of a simulation (`Simulation.state()` / `set_state()`).
 #[pyclass(name = "State", module = "myoslice._myoslice", frozen)]
@@ -138,47 +80,6 @@ fn config(
     c.tissue.rate_hz = tissue_rate_hz;
     c.validate().or_py(py)?;
     Ok(c)
-}
-
-/// A per-element or per-muscle tissue metric as a float32 array (empty without tissue).
-fn metric_array<'py>(
-    py: Python<'py>,
-    sim: &Simulation,
-    pick: impl Fn(&TissueMetrics) -> &Vec<f32>,
-) -> Bound<'py, PyArray1<f32>> {
-    PyArray1::from_vec(
-        py,
-        sim.tissue_metrics()
-            .map_or_else(Vec::new, |m| pick(m).clone()),
-    )
-}
-
-fn check_path(py: Python<'_>, p: &Path, what: &str) -> PyResult<()> {
-    if p.exists() {
-        Ok(())
-    } else {
-        Err(py_err(
-            py,
-            Kind::File,
-            format!("{what} {} does not exist", p.display()),
-        ))
-    }
-}
-
-fn vec3_array<'py>(py: Python<'py>, v: &[Vec3]) -> Bound<'py, PyArray2<f32>> {
-    let flat: Vec<f32> = v.iter().flat_map(|p| p.to_array()).collect();
-    Array2::from_shape_vec((v.len(), 3), flat).map_or_else(
-        |_| PyArray2::zeros(py, (0, 3), false),
-        |a| a.into_pyarray(py),
-    )
-}
-
-fn tri_array<'py>(py: Python<'py>, t: &[[u32; 3]]) -> Bound<'py, PyArray2<u32>> {
-    let flat: Vec<u32> = t.iter().flatten().copied().collect();
-    Array2::from_shape_vec((t.len(), 3), flat).map_or_else(
-        |_| PyArray2::zeros(py, (0, 3), false),
-        |a| a.into_pyarray(py),
-    )
 }
 
 fn gpu(py: Python<'_>) -> PyResult<&'static Gpu> {
@@ -319,6 +220,28 @@ impl PySimulation {
             Ok(())
         })
         .or_py(py)
+    }
+
+    /// Wall-clock time spent in `step` (the Rust side only) since the build or
+    /// `reset_timers`, as a dict.
+    #[getter]
+    fn timers<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let t = self.sim.timers();
+        let d = PyDict::new(py);
+        d.set_item("calls", t.calls)?;
+        d.set_item("steps", t.steps)?;
+        d.set_item("tissue_updates", t.tissue_updates)?;
+        d.set_item("simulated_s", t.simulated_s)?;
+        d.set_item("wall_s", t.wall_s)?;
+        d.set_item("tissue_wall_s", t.tissue_wall_s)?;
+        d.set_item("muscles_wall_s", t.muscles_wall_s())?;
+        d.set_item("realtime_factor", t.realtime_factor())?;
+        Ok(d)
+    }
+
+    /// Starts the step timers from zero.
+    fn reset_timers(&mut self) {
+        self.sim.reset_timers();
     }
 
     /// Sets one muscle's excitation in [0, 1].

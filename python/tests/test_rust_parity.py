@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import statistics
 import subprocess
 import sys
 from pathlib import Path
@@ -104,7 +105,8 @@ def _best(times: list[float]) -> float:
 
 # One timing run of the binding, in a fresh interpreter as the CLI runs in a fresh process:
 # inside the test process the heap left by earlier tests slowed the same Rust steps by up to
-# 7 %, which is the process's history, not the binding's cost.
+# 7 %, which is the process's history, not the binding's cost. Each timed call also reads the
+# simulation's own step timers: the Rust side of the same call, in the same process.
 PYTHON_RUN = """
 import json, sys, time
 from myoslice import Simulation
@@ -115,22 +117,27 @@ def start():
     sim.set_state(initial)
     for name, value in excite.items():
         sim.set_excitation(name, value)
+    sim.reset_timers()
+out = {}
 start()
 t0 = time.perf_counter()
 sim.step(dt, n=steps)
-batched = time.perf_counter() - t0
+out["batched_s"] = time.perf_counter() - t0
+out["batched_rust_s"] = sim.timers["wall_s"]
+out["batched_calls"] = sim.timers["calls"]
 start()
 step = sim.step
 t0 = time.perf_counter()
 for _ in range(steps):
     step(dt)
-looped = time.perf_counter() - t0
-angle = sim.knee_angle
+out["looped_s"] = time.perf_counter() - t0
+out["looped_rust_s"] = sim.timers["wall_s"]
+out["knee_angle"] = sim.knee_angle
 start()
 t0 = time.perf_counter()
 sim.step(dt * steps)
-single = time.perf_counter() - t0
-print(json.dumps({"batched_s": batched, "looped_s": looped, "single_s": single, "knee_angle": angle}))
+out["single_s"] = time.perf_counter() - t0
+print(json.dumps(out))
 """
 
 
@@ -144,36 +151,53 @@ def python_timing(steps: int, dt: float, excite: dict[str, float], cwd: Path) ->
     return report
 
 
+# Across two processes the very same Rust steps differ by more than the binding costs: best
+# of 9 against best of 9, the Rust steps inside a Python process ran 2-8 % slower than in the
+# CLI on this machine (heap and code layout, not the binding), single pairs up to 19 %. So the
+# 5 % bound is held where it measures the binding alone (the same process, the same machine
+# code); the CLI bound only catches a wheel built wrong (a debug wheel is ten times slower).
+BINDING_BOUND = 1.05
+CLI_BOUND = 1.15
+# A call from a Python loop may cost this much more than its Rust step (measured: about 1 us).
+CALL_OVERHEAD_BOUND_US = 5.0
+
+
 def test_throughput_and_call_overhead(tmp_path: Path) -> None:
     steps, dt = 1000, 0.001
     # Interleaved, so that both see the same load on the machine.
-    rust_s, batched_s, looped_s, single_s = [], [], [], []
+    runs: dict[str, list[float]] = {}
     for _ in range(RUNS):
         report = probe(steps, dt, EXCITE)
-        rust_s.append(float(report["wall_s"]))
+        runs.setdefault("cli", []).append(float(report["wall_s"]))
         timing = python_timing(steps, dt, EXCITE, tmp_path)
         # Same steps: the comparison would mean nothing if the two ran different motions.
         assert timing["knee_angle"] == report["knee_angle"]
-        batched_s.append(timing["batched_s"])
-        looped_s.append(timing["looped_s"])
-        single_s.append(timing["single_s"])
-    rust, python, loop = _best(rust_s), _best(batched_s), _best(looped_s)
-    single = _best(single_s)
-    overhead_us = (loop - python) / steps * 1e6
+        # One Rust `step` per step: the batched call loops in Rust, not in Python.
+        assert timing["batched_calls"] == steps
+        for key in ("batched_s", "batched_rust_s", "looped_s", "looped_rust_s", "single_s"):
+            runs.setdefault(key, []).append(timing[key])
+    best = {key: _best(times) for key, times in runs.items()}
+    # The binding's own cost, run by run: the Python timer against the Rust one of the same call.
+    binding = statistics.median(p / r for p, r in zip(runs["batched_s"], runs["batched_rust_s"]))
+    call_us = statistics.median((p - r) / steps * 1e6 for p, r in zip(runs["looped_s"], runs["looped_rust_s"]))
 
     rows = [
-        ("Rust CLI (probe wall_s)", rust * 1e3, "ms"),
-        (f"Python sim.step({dt}, n={steps})", python * 1e3, "ms"),
-        (f"Python loop of {steps} sim.step({dt})", loop * 1e3, "ms"),
-        ("overhead per Python step() call", overhead_us, "us"),
+        ("Rust CLI (probe wall_s)", best["cli"] * 1e3, "ms"),
+        (f"Python sim.step({dt}, n={steps})", best["batched_s"] * 1e3, "ms"),
+        ("  its Rust steps (sim.timers)", best["batched_rust_s"] * 1e3, "ms"),
+        (f"Python loop of {steps} sim.step({dt})", best["looped_s"] * 1e3, "ms"),
+        ("overhead per Python step() call", call_us, "us"),
         # One call for all the steps: one rollback copy instead of one per step.
-        (f"Python sim.step({dt * steps:g}), one call", single * 1e3, "ms"),
+        (f"Python sim.step({dt * steps:g}), one call", best["single_s"] * 1e3, "ms"),
     ]
     summary = f"{steps} steps of {dt * 1e3:g} ms, rigid phantom, best of {RUNS}:\n" + "".join(
         f"  {label:<38}{value:9.2f} {unit}\n" for label, value, unit in rows
     )
+    summary += f"  binding over its own Rust steps: {100 * (binding - 1):+.2f} % (median run)\n"
     print(summary)
     OVERHEAD_FILE.write_text(summary)
 
-    assert math.isfinite(overhead_us)
-    assert python <= rust * 1.05, f"the binding costs more than 5 % over the CLI:\n{summary}"
+    assert math.isfinite(call_us)
+    assert binding <= BINDING_BOUND, f"the binding costs more than 5 % over its Rust steps:\n{summary}"
+    assert call_us <= CALL_OVERHEAD_BOUND_US, f"a Python step() call costs too much:\n{summary}"
+    assert best["batched_s"] <= best["cli"] * CLI_BOUND, f"Python is far slower than the CLI:\n{summary}"

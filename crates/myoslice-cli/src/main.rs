@@ -290,10 +290,12 @@ fn run_scenario(a: &RunArgs) -> Result<()> {
     let summary = w.finish(&sim, t0.elapsed().as_secs_f64())?;
     if !a.quiet {
         println!(
-            "{:.2} s simulated in {:.2} s ({:.2}x real time): knee {:.1}..{:.1}°, {} frames -> {}",
+            "{:.2} s simulated in {:.2} s ({:.2}x real time; muscles {:.2} s, tissue {:.2} s): knee {:.1}..{:.1}°, {} frames -> {}",
             summary.duration_s,
             summary.wall_time_s,
             summary.realtime_factor,
+            summary.muscles_wall_time_s,
+            summary.tissue_wall_time_s,
             summary.knee_angle_range_deg[0],
             summary.knee_angle_range_deg[1],
             summary.frames,

@@ -34,7 +34,7 @@ pub use label_table::{Label, LabelTable, TissueKind};
 pub use label_volume::LabelVolume;
 pub use lattice::{BoneMesh, BuildOptions, FatLattice, Lattice, MuscleLattice, StructureStats};
 pub use report::BuildReport;
-pub use simulation::{Simulation, SimulationConfig};
+pub use simulation::{Simulation, SimulationConfig, StepTimers};
 pub use slices::SliceReduction;
 
 /// The types most programs need.

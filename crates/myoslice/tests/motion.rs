@@ -516,11 +516,21 @@ fn a_failed_call_leaves_no_trace_in_what_follows() {
         );
         b
     };
+    // Every field of every muscle but its work buffers: a step that changed a field the
+    // rollback does not save would show here.
+    let muscles = |s: &Simulation| {
+        let mut m = s.muscles().to_vec();
+        m.iter_mut()
+            .for_each(|m| m.chain.scratch = Default::default());
+        format!("{m:?}")
+    };
     let mut never = start();
     never.step(0.1).unwrap();
     let mut failed = start();
     let before = bits(&failed);
+    let timed = *failed.timers();
     failed.set_excitation("vastus_intermedius", 1.0).unwrap();
+    let before_muscles = muscles(&failed);
     // Strong enough to blow up only after its activation has risen for a few steps, so
     // that the skeleton has moved on before the call fails.
     match failed.step(0.2) {
@@ -528,6 +538,15 @@ fn a_failed_call_leaves_no_trace_in_what_follows() {
         other => panic!("expected a blow-up, got {other:?}"),
     }
     assert_eq!(bits(&failed), before, "the state before the call is back");
+    assert!(
+        muscles(&failed) == before_muscles,
+        "every muscle field is back"
+    );
+    // The failed call's work is timed, but it advanced no simulated time.
+    let t = failed.timers();
+    assert_eq!(t.calls, timed.calls + 1);
+    assert!(t.steps > timed.steps + 2 && t.wall_s > timed.wall_s);
+    assert_eq!(t.simulated_s, timed.simulated_s);
     failed.set_excitation("vastus_intermedius", 0.0).unwrap();
     failed.step(0.1).unwrap();
     assert!(never.knee_velocity().abs() > 0.1, "the knee was moving");
@@ -546,4 +565,25 @@ fn the_same_inputs_give_the_same_bits() {
         )
     };
     assert_eq!(run(), run());
+}
+
+#[test]
+fn step_timers_count_every_call_and_stay_out_of_checkpoints() {
+    let mut s = sim(config());
+    let checkpoint = s.state();
+    assert_eq!(s.timers().calls, 0, "building is not stepping");
+    for _ in 0..3 {
+        s.step(0.01).unwrap();
+    }
+    let t = *s.timers();
+    assert_eq!((t.calls, t.steps, t.tissue_updates), (3, 30, 0));
+    assert!((t.simulated_s - s.time()).abs() < 1e-12);
+    assert!(t.wall_s > 0.0 && t.tissue_wall_s == 0.0 && t.muscles_wall_s() == t.wall_s);
+    assert!(t.realtime_factor().is_some_and(|f| f > 0.0));
+    // Timers measure the machine: restoring a checkpoint leaves them, a reset clears them.
+    s.set_state(&checkpoint).unwrap();
+    assert_eq!(*s.timers(), t);
+    s.reset_timers();
+    assert_eq!(s.timers().calls, 0);
+    assert_eq!(s.timers().realtime_factor(), None);
 }

@@ -154,6 +154,9 @@ fn muscle_volumes_stay_within_one_percent(lattice: Lattice) {
             *r = (r.0.min(*v), r.1.max(*v));
         }
     });
+    let timers = sim.timers();
+    assert!(timers.tissue_updates > 0 && timers.tissue_updates <= timers.steps);
+    assert!(timers.tissue_wall_s > 0.0 && timers.tissue_wall_s < timers.wall_s);
     let lo = range.iter().map(|r| r.0).fold(1.0, f32::min);
     let hi = range.iter().map(|r| r.1).fold(1.0, f32::max);
     let outside: Vec<String> = names

@@ -53,6 +53,11 @@ pub struct RunSummary {
     pub wall_time_s: f64,
     /// Simulated seconds per wall second.
     pub realtime_factor: f64,
+    /// Of the wall time, the part spent stepping the muscles and the skeleton (s); the
+    /// rest of the run's time is the tissue and the writing of outputs.
+    pub muscles_wall_time_s: f64,
+    /// Of the wall time, the part spent on tissue updates within steps (s).
+    pub tissue_wall_time_s: f64,
 }
 
 /// An open run folder.
@@ -109,6 +114,8 @@ impl RunWriter {
                 inverted_elements: 0,
                 wall_time_s: 0.0,
                 realtime_factor: 0.0,
+                muscles_wall_time_s: 0.0,
+                tissue_wall_time_s: 0.0,
             },
         };
         w.row(sim)?;
@@ -206,6 +213,8 @@ impl RunWriter {
         } else {
             0.0
         };
+        self.summary.muscles_wall_time_s = sim.timers().muscles_wall_s();
+        self.summary.tissue_wall_time_s = sim.timers().tissue_wall_s;
         if self.summary.knee_angle_range_deg[0] > self.summary.knee_angle_range_deg[1] {
             self.summary.knee_angle_range_deg = [0.0, 0.0];
         }

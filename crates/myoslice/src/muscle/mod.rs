@@ -2,14 +2,18 @@
 
 pub mod catalogue;
 pub mod chain;
+pub mod dynamics;
 pub mod excursion;
 pub mod hill;
+pub mod snapshot;
 pub mod unit;
 pub mod wrap;
 
 pub use catalogue::{CatalogueEntry, MuscleCatalogue, MuscleGroup, ResolvedMuscle};
-pub use chain::{Attachment, BodyFrames, ChainLoad, ConeAnchor, EndForces, MuscleChain};
+pub use chain::{Attachment, BodyFrames, ConeAnchor, MuscleChain};
+pub use dynamics::{ChainLoad, ChainScratch, EndForces};
 pub use excursion::{Axis, Pull};
 pub use hill::{FibreState, HillForce, HillParams};
+pub use snapshot::MuscleSnapshot;
 pub use unit::{ChainOptions, MUSCLE_DENSITY, MuscleUnit};
 pub use wrap::{WrapCylinder, WrapPath};

@@ -3,7 +3,9 @@
 
 mod config;
 mod schedule;
+mod stepping;
 mod surface;
+mod timers;
 
 use std::sync::Arc;
 
@@ -12,11 +14,13 @@ use glam::Vec3;
 pub use config::{MuscleModel, SimulationConfig};
 pub use schedule::Schedule;
 pub use surface::{Layer, Surface};
+pub use timers::StepTimers;
+
+use stepping::Rollback;
 
 use crate::body::{BodyId, Skeleton, SkeletonOptions, knee_axis};
-use crate::error::{Error, Result, check_positive, check_range};
+use crate::error::{Error, Result, check_range};
 use crate::lattice::{BuildOptions, Lattice};
-use crate::muscle::hill::activation_rate;
 use crate::muscle::{
     Axis, BodyFrames, ChainLoad, ChainOptions, MuscleCatalogue, MuscleGroup, MuscleUnit,
 };
@@ -24,10 +28,6 @@ use crate::tissue::{Tissue, TissueMetrics, bone_surfaces};
 
 /// Simulated time (s) the muscle chains settle at rest before time 0 (see `settle`).
 const SETTLE_S: f64 = 2.0;
-
-/// Largest force (N) one muscle may apply to the shank: a hundred times the strongest
-/// human muscle's; beyond it the step has blown up.
-const MAX_BODY_FORCE_N: f32 = 1e6;
 
 /// What a muscle reports.
 #[derive(Debug, Clone, PartialEq)]
@@ -91,19 +91,8 @@ pub struct Simulation {
     scratch: (Vec<(Vec3, Vec3)>, Vec<ChainLoad>),
     /// Buffers for the state a `step` call started from.
     rollback: Rollback,
-}
-
-/// The muscles as a `step` call found them, in buffers reused from call to call. A clone
-/// of the simulation starts with empty ones: they hold nothing between calls.
-#[derive(Debug, Default)]
-struct Rollback {
-    muscles: Vec<MuscleUnit>,
-}
-
-impl Clone for Rollback {
-    fn clone(&self) -> Self {
-        Self::default()
-    }
+    /// Wall-clock time of the `step` calls.
+    timers: StepTimers,
 }
 
 impl Simulation {
@@ -172,6 +161,7 @@ impl Simulation {
             tissue: None,
             scratch: Default::default(),
             rollback: Rollback::default(),
+            timers: StepTimers::default(),
         };
         // Moment arms (each step's torque report uses the last step's) and wrap state of
         // the chains as built.
@@ -290,6 +280,16 @@ impl Simulation {
     /// Tissue metrics of the last tissue update (None when tissue is disabled).
     pub fn tissue_metrics(&self) -> Option<&TissueMetrics> {
         self.tissue.as_ref().map(|t| &t.metrics)
+    }
+
+    /// Wall-clock time spent in `step` since the build or `reset_timers`.
+    pub fn timers(&self) -> &StepTimers {
+        &self.timers
+    }
+
+    /// Starts the step timers from zero.
+    pub fn reset_timers(&mut self) {
+        self.timers = StepTimers::default();
     }
 
     /// Updates the tissue now for the current pose (also done automatically at
@@ -495,213 +495,6 @@ impl Simulation {
             thigh: (t.rotation, t.translation),
             shank: (s.rotation, s.translation),
         }
-    }
-
-    /// Advances the simulation by `dt` seconds (split into steps of at most
-    /// `max_step_s`). If anything becomes non-finite, the muscles and the skeleton go
-    /// back to their state before the call, the tissue keeps its last good shape, and an
-    /// error says what failed.
-    pub fn step(&mut self, dt: f64) -> Result<()> {
-        check_positive("dt", dt)?;
-        if dt > 10.0 {
-            return Err(Error::invalid("dt", dt, "expected at most 10 s per call"));
-        }
-        let n = (dt / self.config.max_step_s).ceil().max(1.0) as usize;
-        let h = dt / n as f64;
-        // The tissue keeps its own last good shape; the muscles are copied into buffers
-        // kept from call to call (a fresh copy would cost more than a 1 ms step), the
-        // skeleton by its joint state (a clone of the rapier world would cost a seventh).
-        let mut rollback = std::mem::take(&mut self.rollback);
-        rollback.muscles.clone_from(&self.muscles);
-        let skeleton = self.skeleton.snapshot();
-        let saved = (self.time, self.steps, self.frames, self.knee_torque);
-        let restore = |sim: &mut Self, mut rollback: Rollback, what: String| {
-            let t = sim.time;
-            (sim.time, sim.steps, sim.frames, sim.knee_torque) = saved;
-            sim.skeleton.restore(&skeleton);
-            std::mem::swap(&mut sim.muscles, &mut rollback.muscles);
-            sim.rollback = rollback;
-            Err(Error::NonFinite { time: t, what })
-        };
-        for _ in 0..n {
-            if let Some(what) = self.substep(h).or_else(|| self.non_finite()) {
-                return restore(self, rollback, what);
-            }
-            let due = self.tissue.as_mut().is_some_and(|t| t.advance_clock(h));
-            if due && self.update_tissue().is_err() {
-                return restore(self, rollback, "fat or muscle shape".into());
-            }
-        }
-        self.rollback = rollback;
-        Ok(())
-    }
-
-    fn non_finite(&self) -> Option<String> {
-        if !self.knee_angle().is_finite() || !self.knee_velocity().is_finite() {
-            return Some("knee angle".into());
-        }
-        for m in &self.muscles {
-            // A NaN or infinity anywhere makes the sum non-finite (positions are metres:
-            // no finite sum overflows); one branch per muscle instead of one per point.
-            let sum: Vec3 = m.chain.x.iter().copied().sum();
-            if !m.force.is_finite() || !sum.is_finite() {
-                return Some(format!("muscle {}", m.name));
-            }
-        }
-        None
-    }
-
-    /// One step of the muscles and the skeleton; says what failed if it could not run.
-    fn substep(&mut self, h: f64) -> Option<String> {
-        let gravity = self.skeleton.gravity();
-        let knee = *self.skeleton.knee();
-        let hill = self.config.muscle_model == MuscleModel::Hill;
-        let (mut forces, mut loads) = std::mem::take(&mut self.scratch);
-        forces.clear();
-        loads.clear();
-        let mut torque = 0.0;
-        let frames = self.frames;
-        let knee_point = frames.point(BodyId::Thigh, knee.point);
-        let knee_dir = frames.vector(BodyId::Thigh, knee.axis);
-        for (m, sched) in self.muscles.iter_mut().zip(&self.schedules) {
-            if let Some(s) = sched {
-                m.excitation = s.value(self.time);
-            }
-            let load = ChainLoad {
-                contraction: 0.0,
-                stiffness: (self.config.chain_stiffness * m.hill.max_isometric_force) as f32,
-                neutral_springs: hill,
-                gravity,
-            };
-            let quiet = !m.crosses_knee
-                && m.excitation == 0.0
-                && m.activation < 1e-4
-                && m.force < 1e-3 * m.hill.max_isometric_force;
-            if quiet && m.chain.single_body().is_some() {
-                // At rest on one body: no force to compute or apply.
-                m.force = 0.0;
-                m.moment_arm = 0.0;
-                loads.push(load);
-                continue;
-            }
-            let (tension, ends) = if hill {
-                m.fibre = m
-                    .hill
-                    .rigid_tendon_kinematics(m.path_length, m.path_velocity);
-                let f = m.hill.force(m.activation, &m.fibre);
-                m.force = f.tendon;
-                (f.tendon as f32, None)
-            } else {
-                m.activation = m.excitation;
-                let c = (m.excitation * m.hill.max_isometric_force) as f32;
-                let load = ChainLoad {
-                    contraction: c,
-                    ..load
-                };
-                let e = m.chain.end_forces(&load);
-                m.force = f64::from(e.insertion.length());
-                m.fibre = m
-                    .hill
-                    .rigid_tendon_kinematics(m.path_length, m.path_velocity);
-                (c, Some(e))
-            };
-            loads.push(ChainLoad {
-                contraction: tension,
-                ..load
-            });
-            let mut tau = 0.0;
-            if let Some(ends) = ends {
-                // The paper's model: only the end points pull the bones.
-                let n = m.chain.len();
-                let ends_on_shank = [
-                    (m.chain.origin.body, ends.origin, m.chain.x[0]),
-                    (m.chain.insertion.body, ends.insertion, m.chain.x[n - 1]),
-                ];
-                for (body, f, at) in ends_on_shank {
-                    if body == BodyId::Shank {
-                        forces.push((f, at));
-                        tau += f64::from((at - knee_point).cross(f).dot(knee_dir));
-                    }
-                }
-            } else if m.crosses_knee {
-                // The tendon force pulls the shank where the path first reaches it (the
-                // patella for the quadriceps), so the torque is exactly force × moment arm.
-                // (A muscle that does not cross the knee pulls only within its bone.)
-                for p in m.chain.pulls_on(BodyId::Shank) {
-                    let f = p.dir * tension;
-                    forces.push((f, p.at));
-                    tau += f64::from((p.at - knee_point).cross(f).dot(knee_dir));
-                }
-            }
-            m.moment_arm = if m.crosses_knee {
-                m.current_moment_arm
-            } else {
-                0.0
-            };
-            torque += tau;
-        }
-        self.knee_torque = torque;
-        // Rapier quarantines (disables) a body whose pose turns non-finite, which only a
-        // full copy of its world could undo; no muscle pulls with a meganewton, so such
-        // a force is refused before rapier sees it and the step fails cleanly.
-        let unbounded = forces
-            .iter()
-            .find(|(f, at)| !(f.length() <= MAX_BODY_FORCE_N && at.is_finite()));
-        if let Some(&(f, _)) = unbounded {
-            let what = format!("an unbounded muscle force of {} N on the shank", f.length());
-            self.scratch = (forces, loads);
-            return Some(what);
-        }
-        if !self.skeleton.step(h, &forces) {
-            self.scratch = (forces, loads);
-            return Some("the shank's pose (rapier stopped it)".into());
-        }
-        let next = self.current_frames();
-        // The thigh is fixed: the shank turns about the knee axis, so the path lengthens at
-        // −(moment arm) × knee velocity (virtual work).
-        let knee_velocity = self.skeleton.knee_velocity();
-        let axis = Axis {
-            point: next.point(BodyId::Thigh, knee.point),
-            dir: next.vector(BodyId::Thigh, knee.axis),
-        };
-        for (m, load) in self.muscles.iter_mut().zip(&loads) {
-            // A muscle at rest on one body is carried with it; only loaded or
-            // knee-crossing chains need their dynamics.
-            let quiet = m.excitation == 0.0
-                && m.activation < 1e-4
-                && m.force < 1e-3 * m.hill.max_isometric_force;
-            match m.chain.single_body() {
-                Some(b) if quiet => m.chain.carry(b, &frames, &next, h as f32),
-                _ => {
-                    m.chain.advance(h as f32, &next, load);
-                }
-            }
-            if hill {
-                let rate = activation_rate(
-                    m.excitation,
-                    m.activation,
-                    m.hill.tau_activation,
-                    m.hill.tau_deactivation,
-                    10.0,
-                );
-                m.activation = (m.activation + h * rate).clamp(0.0, 1.0);
-            }
-            m.path_length = m.chain.path_length();
-            if m.crosses_knee {
-                // Computed once per step on the new geometry; the next step's torque
-                // report and the fibre velocity both use it.
-                m.current_moment_arm = m.chain.moment_arm(&axis, BodyId::Shank);
-                m.path_velocity = -m.current_moment_arm * knee_velocity;
-            } else {
-                // Both ends and every cone on one rigid body: no excursion.
-                m.path_velocity = 0.0;
-            }
-        }
-        self.frames = next;
-        self.time += h;
-        self.steps += 1;
-        self.scratch = (forces, loads);
-        None
     }
 
     /// A checkpoint of everything that changes while stepping.
