@@ -6,7 +6,7 @@ a fresh copy: writing to it does not change the simulation.
 """
 
 import os
-from typing import TypeAlias, final
+from typing import TypeAlias, TypedDict, final
 
 import numpy as np
 import numpy.typing as npt
@@ -16,6 +16,18 @@ __all__ = ["Simulation", "State", "__version__"]
 _StrPath: TypeAlias = str | os.PathLike[str]
 
 __version__: str
+
+class _StepTimers(TypedDict):
+    """What :attr:`Simulation.timers` returns (seconds of wall-clock time, on the Rust side)."""
+
+    calls: int
+    steps: int
+    tissue_updates: int
+    simulated_s: float
+    wall_s: float
+    tissue_wall_s: float
+    muscles_wall_s: float
+    realtime_factor: float | None
 
 @final
 class State:
@@ -76,7 +88,7 @@ class Simulation:
         """Advances ``n`` steps of ``dt`` seconds (the GIL is released meanwhile)."""
 
     @property
-    def timers(self) -> dict[str, float | int | None]:
+    def timers(self) -> _StepTimers:
         """Wall-clock time spent in :meth:`step` on the Rust side since the build or
         :meth:`reset_timers`: ``calls``, ``steps``, ``tissue_updates`` (counts),
         ``simulated_s``, ``wall_s``, ``tissue_wall_s``, ``muscles_wall_s`` (seconds) and

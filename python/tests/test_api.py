@@ -194,6 +194,27 @@ def test_step_advances_time_by_dt_times_n(rigid: Simulation) -> None:
     assert rigid.time == pytest.approx(t0 + 0.013, rel=0, abs=1e-12)
 
 
+def test_timers_count_the_rust_side_of_each_step_call(tissue: Simulation) -> None:
+    tissue.reset_timers()
+    assert tissue.timers["calls"] == 0 and tissue.timers["realtime_factor"] is None
+    tissue.step(0.001, n=40)
+    t = tissue.timers
+    assert set(t) == {
+        "calls", "steps", "tissue_updates", "simulated_s", "wall_s", "tissue_wall_s",
+        "muscles_wall_s", "realtime_factor",
+    }
+    assert (t["calls"], t["steps"]) == (40, 40)
+    assert t["simulated_s"] == pytest.approx(0.04, rel=1e-12)
+    # 40 ms at the default 30 Hz holds one or two tissue updates.
+    assert 1 <= t["tissue_updates"] <= 2
+    assert 0.0 < t["tissue_wall_s"] < t["wall_s"]
+    assert t["muscles_wall_s"] == pytest.approx(t["wall_s"] - t["tissue_wall_s"])
+    assert t["realtime_factor"] == pytest.approx(t["simulated_s"] / t["wall_s"])
+    # Checkpoints are about the model, timers about the machine.
+    tissue.set_state(tissue.state())
+    assert tissue.timers == t
+
+
 def test_set_excitation_single(rigid: Simulation) -> None:
     rigid.set_excitation("semimembranosus", 0.25)
     e = rigid.excitations
