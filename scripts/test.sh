@@ -46,7 +46,13 @@ python3 -m venv .venv-test
 .venv-test/bin/python -m pip install -q "maturin>=1.9.4,<2" -r python/requirements-test.txt
 step "building and installing the wheel"
 rm -rf target/wheels
-.venv-test/bin/maturin build --release -m python/Cargo.toml -o target/wheels
+.venv-test/bin/maturin build --release -m python/Cargo.toml -o target/wheels 2>&1 | tee target/maturin-build.log
+# The wheel must link the core the CLI was built with (crates/workspace-hack): a second
+# build of it means the dependency features diverged, and the Python parity figures with it.
+if grep -q "Compiling myoslice v" target/maturin-build.log; then
+    echo "the wheel compiled its own build of the core: align crates/workspace-hack (cargo tree -e features)" >&2
+    exit 1
+fi
 .venv-test/bin/python -m pip install -q --force-reinstall --no-deps target/wheels/myoslice-*.whl
 step "pytest"
 # From the repository root, so that the installed wheel (not python/myoslice/) is imported.
