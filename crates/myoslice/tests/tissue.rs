@@ -274,3 +274,37 @@ fn every_tissue_vertex_stays_finite_at_three_times_the_speed() {
     });
     assert!(finite);
 }
+
+#[test]
+fn a_failed_call_leaves_the_tissue_clock_where_it_was() {
+    let mut cat = MuscleCatalogue::default();
+    cat.muscles
+        .get_mut("vastus_intermedius")
+        .unwrap()
+        .max_isometric_force_n = Some(3e6);
+    let mut sim = Simulation::new(phantom_lattice(), SimulationConfig::default(), &cat).unwrap();
+    let period = sim.tissue().unwrap().period();
+    // Just past an update: the failing call below ends before the next one is due.
+    sim.step(period).unwrap();
+    let mut twin = sim.clone();
+    sim.set_excitation("vastus_intermedius", 1.0).unwrap();
+    let failed_at = match sim.step(0.5 * period) {
+        Err(Error::NonFinite { time, .. }) => time,
+        other => panic!("expected a blow-up, got {other:?}"),
+    };
+    assert!(
+        failed_at > period,
+        "the call failed after stepping, at {failed_at} s"
+    );
+    sim.set_excitation("vastus_intermedius", 0.0).unwrap();
+    // Both now step a little less than a period: a clock left advanced by the failed call
+    // would update the tissue within it.
+    let before = (sim.timers().tissue_updates, twin.timers().tissue_updates);
+    sim.step(0.9 * period).unwrap();
+    twin.step(0.9 * period).unwrap();
+    assert_eq!(
+        sim.timers().tissue_updates - before.0,
+        twin.timers().tissue_updates - before.1
+    );
+    assert_eq!(sim.time().to_bits(), twin.time().to_bits());
+}

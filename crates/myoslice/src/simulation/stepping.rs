@@ -30,9 +30,10 @@ impl Clone for Rollback {
 
 impl Simulation {
     /// Advances the simulation by `dt` seconds (split into steps of at most
-    /// `max_step_s`). If anything becomes non-finite, the muscles and the skeleton go
-    /// back to their state before the call, the tissue keeps its last good shape, and an
-    /// error says what failed.
+    /// `max_step_s`). If anything becomes non-finite, the muscles, the skeleton and the
+    /// tissue's clock go back to their state before the call, the tissue keeps its last
+    /// good shape (a copy of it would cost a tenth of its update), and an error says what
+    /// failed.
     pub fn step(&mut self, dt: f64) -> Result<()> {
         check_positive("dt", dt)?;
         if dt > 10.0 {
@@ -48,6 +49,9 @@ impl Simulation {
         rollback.muscles.save(&self.muscles);
         let skeleton = self.skeleton.snapshot();
         let saved = (self.time, self.steps, self.frames, self.knee_torque);
+        // The tissue's clock too, so that its updates fall where a twin that never failed
+        // has them.
+        let clock = self.tissue.as_ref().map(|t| t.pending);
         let mut failure = None;
         let mut taken = 0;
         for _ in 0..n {
@@ -72,6 +76,9 @@ impl Simulation {
                 let time = self.time;
                 (self.time, self.steps, self.frames, self.knee_torque) = saved;
                 self.skeleton.restore(&skeleton);
+                if let (Some(t), Some(pending)) = (&mut self.tissue, clock) {
+                    t.pending = pending;
+                }
                 let what = if rollback.muscles.restore(&mut self.muscles) {
                     what
                 } else {
