@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import statistics
 import subprocess
 import sys
@@ -98,6 +99,30 @@ def test_bit_for_bit_parity(fresh_rigid: tuple[Simulation, State], steps: int, t
     assert sim.knee_angle != 0.0  # the excitations did something
 
 
+# The legacy-mangled symbol of the core's `Simulation::step`: its hash names the build of
+# the core (it changes with the features its dependencies were built with).
+STEP_SYMBOL = re.compile(rb"_ZN8myoslice10simulation8stepping[0-9A-Za-z_$.]*?4step17h([0-9a-f]{16})E")
+
+
+def _core_build(path: Path) -> bytes:
+    found: set[bytes] = {m.group(1) for m in STEP_SYMBOL.finditer(path.read_bytes())}
+    assert len(found) == 1, f"{path}: expected one Simulation::step symbol, found {sorted(found)}"
+    return found.pop()
+
+
+def test_the_wheel_and_the_cli_link_one_build_of_the_core() -> None:
+    # Two builds of the same core source ran the same steps 5-10 % apart; the timings
+    # below compare like with like only if both link the same one (crates/workspace-hack).
+    import myoslice._myoslice as ext
+
+    assert ext.__file__ is not None
+    wheel, reference = _core_build(Path(ext.__file__)), _core_build(cli())
+    assert wheel == reference, (
+        f"the wheel's core ({wheel.decode()}) is another build than the CLI's ({reference.decode()}): "
+        "align the dependency features in crates/workspace-hack (cargo tree -e features)"
+    )
+
+
 def _best(times: list[float]) -> float:
     assert all(math.isfinite(t) and t >= 0.0 for t in times), times
     return min(times)
@@ -158,7 +183,7 @@ def python_timing(steps: int, dt: float, excite: dict[str, float], cwd: Path) ->
 # code); the CLI bound only catches a wheel built wrong (a debug wheel is ten times slower).
 BINDING_BOUND = 1.05
 CLI_BOUND = 1.15
-# A call from a Python loop may cost this much more than its Rust step (measured: about 1 us).
+# A call from a Python loop may cost this much more than its Rust step (measured: under 1 us).
 CALL_OVERHEAD_BOUND_US = 5.0
 
 

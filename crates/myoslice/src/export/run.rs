@@ -53,10 +53,11 @@ pub struct RunSummary {
     pub wall_time_s: f64,
     /// Simulated seconds per wall second.
     pub realtime_factor: f64,
-    /// Of the wall time, the part spent stepping the muscles and the skeleton (s); the
-    /// rest of the run's time is the tissue and the writing of outputs.
+    /// Of the wall time, the part spent on the muscles and the skeleton inside `step`
+    /// (s). The rest is the build, the tissue and the writing of outputs.
     pub muscles_wall_time_s: f64,
-    /// Of the wall time, the part spent on tissue updates within steps (s).
+    /// Of the wall time, the part spent on the tissue updates inside `step` (s); the
+    /// updates for output frames are not in it.
     pub tissue_wall_time_s: f64,
 }
 

@@ -5,7 +5,7 @@ pub mod chain;
 pub mod dynamics;
 pub mod excursion;
 pub mod hill;
-pub mod snapshot;
+pub(crate) mod snapshot;
 pub mod unit;
 pub mod wrap;
 
@@ -14,6 +14,6 @@ pub use chain::{Attachment, BodyFrames, ConeAnchor, MuscleChain};
 pub use dynamics::{ChainLoad, ChainScratch, EndForces};
 pub use excursion::{Axis, Pull};
 pub use hill::{FibreState, HillForce, HillParams};
-pub use snapshot::MuscleSnapshot;
+pub(crate) use snapshot::MuscleSnapshot;
 pub use unit::{ChainOptions, MUSCLE_DENSITY, MuscleUnit};
 pub use wrap::{WrapCylinder, WrapPath};

@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 
-use super::chain::SegmentGeom;
+use super::chain::{MuscleChain, SegmentGeom};
 use super::hill::FibreState;
 use super::unit::MuscleUnit;
 
@@ -12,7 +12,7 @@ use super::unit::MuscleUnit;
 /// alone, so this is all a rollback needs; a full copy of the muscles cost 3.8 µs on the
 /// phantom, a sixth of a 1 ms step.
 #[derive(Debug, Clone, Default)]
-pub struct MuscleSnapshot {
+pub(crate) struct MuscleSnapshot {
     x: Vec<Vec3>,
     v: Vec<Vec3>,
     geom: Vec<SegmentGeom>,
@@ -36,35 +36,74 @@ struct UnitState {
 
 impl MuscleSnapshot {
     /// Saves the muscles' changing state (replacing what was saved).
-    pub fn save(&mut self, muscles: &[MuscleUnit]) {
+    pub(crate) fn save(&mut self, muscles: &[MuscleUnit]) {
         self.x.clear();
         self.v.clear();
         self.geom.clear();
         self.units.clear();
         for m in muscles {
-            let c = &m.chain;
-            self.x.extend_from_slice(&c.x);
-            self.v.extend_from_slice(&c.v);
-            self.geom.extend_from_slice(&c.geom);
+            // Every field named, so that a new one needs a decision here: saved, or left
+            // alone by stepping.
+            let MuscleUnit {
+                name: _,
+                lattice_index: _,
+                group: _,
+                hill: _,
+                chain: c,
+                crosses_knee: _,
+                mass: _,
+                bones: _,
+                from_catalogue: _,
+                excitation,
+                activation,
+                path_length,
+                path_velocity,
+                force,
+                fibre,
+                moment_arm,
+                current_moment_arm,
+            } = m;
+            let MuscleChain {
+                origin: _,
+                insertion: _,
+                x,
+                v,
+                mass: _,
+                rest_len: _,
+                tendon: _,
+                cones: _,
+                vias: _,
+                cone_cos_tan: _,
+                wrap: _,
+                wrap_segment: _,
+                wrapped,
+                belly_rest: _,
+                scratch: _,
+                geom,
+                bodies: _,
+            } = c;
+            self.x.extend_from_slice(x);
+            self.v.extend_from_slice(v);
+            self.geom.extend_from_slice(geom);
             self.units.push(UnitState {
-                points: c.x.len(),
-                segments: c.geom.len(),
-                wrapped: c.wrapped,
-                excitation: m.excitation,
-                activation: m.activation,
-                path_length: m.path_length,
-                path_velocity: m.path_velocity,
-                force: m.force,
-                fibre: m.fibre,
-                moment_arm: m.moment_arm,
-                current_moment_arm: m.current_moment_arm,
+                points: x.len(),
+                segments: geom.len(),
+                wrapped: *wrapped,
+                excitation: *excitation,
+                activation: *activation,
+                path_length: *path_length,
+                path_velocity: *path_velocity,
+                force: *force,
+                fibre: *fibre,
+                moment_arm: *moment_arm,
+                current_moment_arm: *current_moment_arm,
             });
         }
     }
 
-    /// Puts the saved state back into the same muscles; false (and nothing changed) if
-    /// they are not the ones saved.
-    pub fn restore(&self, muscles: &mut [MuscleUnit]) -> bool {
+    /// Puts the saved state back into the muscles it was saved from; false (and nothing
+    /// changed) if their number or chain lengths differ from what was saved.
+    pub(crate) fn restore(&self, muscles: &mut [MuscleUnit]) -> bool {
         let same = muscles.len() == self.units.len()
             && muscles
                 .iter()

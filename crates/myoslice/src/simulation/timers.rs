@@ -3,8 +3,8 @@
 use std::time::Duration;
 
 /// Wall-clock time spent inside [`Simulation::step`](crate::Simulation::step) since the
-/// simulation was built or the timers were reset, split into the tissue updates and the
-/// rest (muscles and skeleton).
+/// simulation was built (a clone starts with its original's) or the timers were reset,
+/// split into the tissue updates and the rest (muscles and skeleton).
 ///
 /// They measure the machine, not the model: they are never part of a checkpoint, and
 /// `set_state` leaves them alone. Reading them from Python next to a timer of the call
@@ -18,7 +18,7 @@ use std::time::Duration;
 /// ```
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct StepTimers {
-    /// `step` calls, failed ones included.
+    /// `step` calls that ran, failed ones included (not those refused for their `dt`).
     pub calls: u64,
     /// Muscle and skeleton steps taken (of at most `max_step_s` each), failed calls' included.
     pub steps: u64,
