@@ -310,3 +310,53 @@ fn a_failed_call_leaves_the_tissue_clock_where_it_was() {
     );
     assert_eq!(sim.time().to_bits(), twin.time().to_bits());
 }
+
+#[test]
+fn a_failed_call_leaves_no_trace_in_the_tissue() {
+    let mut cat = MuscleCatalogue::default();
+    cat.muscles
+        .get_mut("vastus_intermedius")
+        .unwrap()
+        .max_isometric_force_n = Some(3e6);
+    let mut sim = Simulation::new(phantom_lattice(), SimulationConfig::default(), &cat).unwrap();
+    let period = sim.tissue().unwrap().period();
+    sim.set_excitation("semimembranosus", 0.8).unwrap();
+    sim.step(period).unwrap();
+    // The next update falls a tenth of a period into the failing call, before it fails.
+    sim.step(0.9 * period).unwrap();
+    let bits = |s: &Simulation| {
+        let t = s.tissue().unwrap();
+        let mut b = vec![s.time().to_bits(), s.knee_angle().to_bits()];
+        let points = t
+            .fat_vertices()
+            .iter()
+            .chain(t.muscles.iter().flat_map(|m| &m.current));
+        b.extend(
+            points
+                .flat_map(|p| p.to_array())
+                .map(|c| u64::from(c.to_bits())),
+        );
+        b.extend(t.metrics.area_change.iter().map(|c| u64::from(c.to_bits())));
+        b
+    };
+    let mut twin = sim.clone();
+    let before = bits(&sim);
+    let updates = sim.timers().tissue_updates;
+    sim.set_excitation("vastus_intermedius", 1.0).unwrap();
+    assert!(matches!(
+        sim.step(0.5 * period),
+        Err(Error::NonFinite { .. })
+    ));
+    assert!(
+        sim.timers().tissue_updates > updates,
+        "the failed call updated the tissue"
+    );
+    assert!(bits(&sim) == before, "the tissue before the call is back");
+    sim.set_excitation("vastus_intermedius", 0.0).unwrap();
+    sim.step(period).unwrap();
+    twin.step(period).unwrap();
+    assert!(
+        bits(&sim) == bits(&twin),
+        "what follows is what a twin that never failed does"
+    );
+}

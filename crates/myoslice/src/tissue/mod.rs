@@ -175,6 +175,21 @@ pub struct Tissue {
     pub(crate) pending: f64,
 }
 
+/// A tissue's changing state, to put back after a failed update or `step` call.
+#[derive(Debug)]
+pub(crate) struct TissueBackup {
+    fat_x: Vec<Vec3>,
+    fat_rot: Vec<Quat>,
+    fat_free: Vec<bool>,
+    fat_active: Vec<bool>,
+    drift: Vec<Vec3>,
+    theta: f32,
+    metrics: TissueMetrics,
+    bone_slide: BoneSlide,
+    muscles: Vec<(Vec<Vec3>, f64, Vec<Vec3>)>,
+    pending: f64,
+}
+
 impl Tissue {
     /// Binds the tissue of a lattice to its muscles at rest.
     pub fn new(
@@ -304,38 +319,63 @@ impl Tissue {
     /// Deforms muscles and fat for the current skeleton and chains. Returns false (and
     /// keeps the previous shape) if anything became non-finite.
     pub fn update(&mut self, knee_angle: f64, frames: &BodyFrames, muscles: &[MuscleUnit]) -> bool {
-        // Everything an update changes, to put back if it fails.
-        let backup = (
-            self.fat.x.clone(),
-            self.fat.rot.clone(),
-            self.fat.free.clone(),
-            self.fat.active.clone(),
-            self.drift.clone(),
-            self.theta,
-            self.metrics.clone(),
-            self.bone_slide.clone(),
-            self.muscles
-                .iter()
-                .map(|m| (m.current.clone(), m.volume_now, m.keep.shift.clone()))
-                .collect::<Vec<_>>(),
-        );
+        let backup = self.backup();
+        let ok = self.update_unguarded(knee_angle, frames, muscles);
+        if !ok {
+            self.restore(backup);
+        }
+        ok
+    }
+
+    /// [`Self::update`] without its own backup: the caller puts back a [`TissueBackup`]
+    /// if this returns false (a `step` call backs up once, before its first update).
+    pub(crate) fn update_unguarded(
+        &mut self,
+        knee_angle: f64,
+        frames: &BodyFrames,
+        muscles: &[MuscleUnit],
+    ) -> bool {
         self.deform(knee_angle, frames, muscles);
-        let ok = self.fat.x.iter().all(|p| p.is_finite())
+        self.fat.x.iter().all(|p| p.is_finite())
             && self.drift.iter().all(|p| p.is_finite())
             && self
                 .muscles
                 .iter()
-                .all(|m| m.current.iter().all(|p| p.is_finite()));
-        if !ok {
-            let (x, rot, free, active, drift, theta, metrics, slide, current) = backup;
-            (self.fat.x, self.fat.rot, self.fat.free, self.fat.active) = (x, rot, free, active);
-            (self.drift, self.theta, self.metrics) = (drift, theta, metrics);
-            self.bone_slide = slide;
-            for (shape, (c, v, shift)) in self.muscles.iter_mut().zip(current) {
-                (shape.current, shape.volume_now, shape.keep.shift) = (c, v, shift);
-            }
+                .all(|m| m.current.iter().all(|p| p.is_finite()))
+    }
+
+    /// Everything an update changes and the next one reads (the pairs watched against
+    /// bone only skip checks a ball known clear of the bone vouches for, whatever its
+    /// age, so they need no backup).
+    pub(crate) fn backup(&self) -> TissueBackup {
+        TissueBackup {
+            fat_x: self.fat.x.clone(),
+            fat_rot: self.fat.rot.clone(),
+            fat_free: self.fat.free.clone(),
+            fat_active: self.fat.active.clone(),
+            drift: self.drift.clone(),
+            theta: self.theta,
+            metrics: self.metrics.clone(),
+            bone_slide: self.bone_slide.clone(),
+            muscles: self
+                .muscles
+                .iter()
+                .map(|m| (m.current.clone(), m.volume_now, m.keep.shift.clone()))
+                .collect(),
+            pending: self.pending,
         }
-        ok
+    }
+
+    /// Puts back what [`Self::backup`] took.
+    pub(crate) fn restore(&mut self, b: TissueBackup) {
+        (self.fat.x, self.fat.rot) = (b.fat_x, b.fat_rot);
+        (self.fat.free, self.fat.active) = (b.fat_free, b.fat_active);
+        (self.drift, self.theta, self.metrics) = (b.drift, b.theta, b.metrics);
+        self.bone_slide = b.bone_slide;
+        for (shape, (c, v, shift)) in self.muscles.iter_mut().zip(b.muscles) {
+            (shape.current, shape.volume_now, shape.keep.shift) = (c, v, shift);
+        }
+        self.pending = b.pending;
     }
 
     fn deform(&mut self, knee_angle: f64, frames: &BodyFrames, muscles: &[MuscleUnit]) {
