@@ -272,6 +272,17 @@ impl UiState {
             ui.label("frame / sim");
             ui.label(format!("{:.1} ms / {:.1} ms", self.frame_ms, self.sim_ms));
             ui.end_row();
+            // The core's own step timers, since the start: how fast the model runs here
+            // and how much of it the tissue takes.
+            let t = sim.timers();
+            if let Some(f) = t.realtime_factor() {
+                ui.label("stepping");
+                ui.label(format!(
+                    "{f:.2}× real time, tissue {:.0} %",
+                    100.0 * t.tissue_wall_s / t.wall_s
+                ));
+                ui.end_row();
+            }
             ui.label("elements");
             ui.label(format!(
                 "{} fat hex, {} muscles, {} bones",
