@@ -29,6 +29,12 @@ class _StepTimers(TypedDict):
     muscles_wall_s: float
     realtime_factor: float | None
 
+class _MusclesInBone(TypedDict):
+    """What :meth:`Simulation.muscles_in_bone` returns, one entry per muscle."""
+
+    vertices_over_1mm: npt.NDArray[np.int64]
+    deepest_m: npt.NDArray[np.float32]
+
 @final
 class State:
     """An opaque checkpoint of a :class:`Simulation` (``Simulation.state()``)."""
@@ -175,6 +181,12 @@ class Simulation:
     def muscle_volume_ratio(self) -> npt.NDArray[np.float32]:
         """Volume over rest volume of each muscle, float32 ``(n_muscles,)``; shape
         ``(0,)`` without tissue."""
+
+    def muscles_in_bone(self) -> _MusclesInBone:
+        """How far each muscle's surface reaches into bone now, in :attr:`muscle_names`
+        order: ``vertices_over_1mm`` (int64, vertices more than 1 mm inside a bone) and
+        ``deepest_m`` (float32, m); empty arrays without tissue. Exact (a tree query per
+        vertex near a bone): tens of milliseconds, for checks rather than every frame."""
 
     @property
     def n_fat_elements(self) -> int:

@@ -445,6 +445,19 @@ impl PySimulation {
         metric_array(py, &self.sim, |m| &m.muscle_volume_ratio)
     }
 
+    /// How far each muscle's surface reaches into bone now: a dict of per-muscle arrays
+    /// `vertices_over_1mm` (int64) and `deepest_m` (float32), empty without tissue.
+    fn muscles_in_bone<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let sim = &self.sim;
+        let o = py.detach(|| sim.muscles_in_bone()).unwrap_or_default();
+        let d = PyDict::new(py);
+        let count: Vec<i64> = o.iter().map(|b| b.vertices_over_1mm as i64).collect();
+        let deepest: Vec<f32> = o.iter().map(|b| b.deepest_m).collect();
+        d.set_item("vertices_over_1mm", PyArray1::from_vec(py, count))?;
+        d.set_item("deepest_m", PyArray1::from_vec(py, deepest))?;
+        Ok(d)
+    }
+
     /// Number of fat elements (hexahedra).
     #[getter]
     fn n_fat_elements(&self) -> usize {

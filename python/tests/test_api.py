@@ -215,6 +215,24 @@ def test_timers_count_the_rust_side_of_each_step_call(tissue: Simulation) -> Non
     assert tissue.timers == t
 
 
+def test_muscles_in_bone_per_muscle(tissue: Simulation, rigid: Simulation) -> None:
+    flex(tissue, 0.3)
+    r = tissue.muscles_in_bone()
+    assert set(r) == {"vertices_over_1mm", "deepest_m"}
+    count, deepest = r["vertices_over_1mm"], r["deepest_m"]
+    n = len(tissue.muscle_names)
+    assert count.shape == (n,) and count.dtype == np.int64
+    assert deepest.shape == (n,) and deepest.dtype == np.float32
+    assert (count >= 0).all() and (deepest >= 0.0).all() and np.isfinite(deepest).all()
+    # A muscle with a vertex over 1 mm deep counts it, and one that counts none has none.
+    assert ((deepest > 1e-3) == (count > 0)).all()
+    # The phantom's slices overlap a little (obturator internus in the hip bone, about
+    # 11 mm at rest); nothing goes deeper than a couple of centimetres.
+    assert 0.0 < deepest.max() < 0.02
+    empty = rigid.muscles_in_bone()
+    assert empty["vertices_over_1mm"].shape == (0,) and empty["deepest_m"].shape == (0,)
+
+
 def test_set_excitation_single(rigid: Simulation) -> None:
     rigid.set_excitation("semimembranosus", 0.25)
     e = rigid.excitations

@@ -24,7 +24,7 @@ use crate::lattice::{BuildOptions, Lattice};
 use crate::muscle::{
     Axis, BodyFrames, ChainLoad, ChainOptions, MuscleCatalogue, MuscleGroup, MuscleUnit,
 };
-use crate::tissue::{Tissue, TissueMetrics, bone_surfaces};
+use crate::tissue::{BoneOverlap, Tissue, TissueMetrics, bone_surfaces};
 
 /// Simulated time (s) the muscle chains settle at rest before time 0 (see `settle`).
 const SETTLE_S: f64 = 2.0;
@@ -280,6 +280,15 @@ impl Simulation {
     /// Tissue metrics of the last tissue update (None when tissue is disabled).
     pub fn tissue_metrics(&self) -> Option<&TissueMetrics> {
         self.tissue.as_ref().map(|t| &t.metrics)
+    }
+
+    /// How far each muscle's surface reaches into bone now, in muscle order (exact: a
+    /// tree query per muscle vertex near a bone, tens of milliseconds; for checks, not
+    /// every frame). None when tissue is disabled.
+    pub fn muscles_in_bone(&self) -> Option<Vec<BoneOverlap>> {
+        self.tissue
+            .as_ref()
+            .map(|t| t.muscles_in_bone(&self.frames))
     }
 
     /// Wall-clock time spent in `step` since the build or `reset_timers`.
