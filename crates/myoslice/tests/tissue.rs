@@ -33,12 +33,7 @@ fn tissue_of(sim: &Simulation) -> Tissue {
 
 #[test]
 fn rigid_motions_leave_no_deformation_and_no_area_change() {
-    let sim = Simulation::new(
-        phantom_lattice(),
-        SimulationConfig::default(),
-        &MuscleCatalogue::default(),
-    )
-    .unwrap();
+    let sim = Simulation::phantom(SimulationConfig::default()).unwrap();
     let mut t = tissue_of(&sim);
     let q = Quat::from_axis_angle(Vec3::new(0.2, 1.0, 0.4).normalize(), 0.9);
     let shift = Vec3::new(0.3, -0.1, 0.25);
@@ -61,12 +56,7 @@ fn rigid_motions_leave_no_deformation_and_no_area_change() {
 
 #[test]
 fn stretched_skin_shows_positive_area_change_and_compressed_skin_negative() {
-    let sim = Simulation::new(
-        phantom_lattice(),
-        SimulationConfig::default(),
-        &MuscleCatalogue::default(),
-    )
-    .unwrap();
+    let sim = Simulation::phantom(SimulationConfig::default()).unwrap();
     let lat = sim.lattice();
     let fat = &lat.fat;
     let mut t = tissue_of(&sim);
@@ -192,12 +182,7 @@ fn muscle_volume_is_conserved_through_a_deep_flexion_of_the_visible_human_leg() 
 }
 
 fn tissue_never_breaks(speed: f64) {
-    let mut sim = Simulation::new(
-        phantom_lattice(),
-        SimulationConfig::default(),
-        &MuscleCatalogue::default(),
-    )
-    .unwrap();
+    let mut sim = Simulation::phantom(SimulationConfig::default()).unwrap();
     let tri = sim.lattice().fat.surface_triangles();
     let (mut inverted, mut crossings, mut finite) = (0usize, 0usize, true);
     flex_and_back(&mut sim, speed, |s| {
@@ -228,17 +213,12 @@ fn fat_never_inverts_nor_self_intersects_at_three_times_the_speed() {
 
 #[test]
 fn muscles_are_kept_out_of_bone_through_a_deep_flexion() {
-    let mut sim = Simulation::new(
-        phantom_lattice(),
-        SimulationConfig::default(),
-        &MuscleCatalogue::default(),
-    )
-    .unwrap();
-    let rest = sim.tissue().unwrap().muscles_in_bone(sim.frames());
+    let mut sim = Simulation::phantom(SimulationConfig::default()).unwrap();
+    let rest = sim.muscles_in_bone().unwrap();
     let at_rest: usize = rest.iter().map(|o| o.vertices_over_1mm).sum();
     let (mut added, mut deepest) = (0usize, 0.0f32);
     flex_and_back(&mut sim, 1.0, |s| {
-        let now = s.tissue().unwrap().muscles_in_bone(s.frames());
+        let now = s.muscles_in_bone().unwrap();
         let count: usize = now.iter().map(|o| o.vertices_over_1mm).sum();
         added = added.max(count.saturating_sub(at_rest));
         for (n, r) in now.iter().zip(&rest) {
@@ -257,12 +237,7 @@ fn muscles_are_kept_out_of_bone_through_a_deep_flexion() {
 
 #[test]
 fn every_tissue_vertex_stays_finite_at_three_times_the_speed() {
-    let mut sim = Simulation::new(
-        phantom_lattice(),
-        SimulationConfig::default(),
-        &MuscleCatalogue::default(),
-    )
-    .unwrap();
+    let mut sim = Simulation::phantom(SimulationConfig::default()).unwrap();
     let mut finite = true;
     flex_and_back(&mut sim, 3.0, |s| {
         let t = s.tissue().unwrap();
