@@ -187,7 +187,6 @@ pub(crate) struct TissueBackup {
     metrics: TissueMetrics,
     bone_slide: BoneSlide,
     muscles: Vec<(Vec<Vec3>, f64, Vec<Vec3>)>,
-    pending: f64,
 }
 
 impl Tissue {
@@ -344,9 +343,9 @@ impl Tissue {
                 .all(|m| m.current.iter().all(|p| p.is_finite()))
     }
 
-    /// Everything an update changes and the next one reads (the pairs watched against
-    /// bone only skip checks a ball known clear of the bone vouches for, whatever its
-    /// age, so they need no backup).
+    /// Everything an update changes and the next one reads. Not the clock: `step`
+    /// advances it and puts it back itself. Not the pairs watched against bone: they only
+    /// skip checks a ball known clear of the bone vouches for, whatever its age.
     pub(crate) fn backup(&self) -> TissueBackup {
         TissueBackup {
             fat_x: self.fat.x.clone(),
@@ -362,7 +361,6 @@ impl Tissue {
                 .iter()
                 .map(|m| (m.current.clone(), m.volume_now, m.keep.shift.clone()))
                 .collect(),
-            pending: self.pending,
         }
     }
 
@@ -375,7 +373,6 @@ impl Tissue {
         for (shape, (c, v, shift)) in self.muscles.iter_mut().zip(b.muscles) {
             (shape.current, shape.volume_now, shape.keep.shift) = (c, v, shift);
         }
-        self.pending = b.pending;
     }
 
     fn deform(&mut self, knee_angle: f64, frames: &BodyFrames, muscles: &[MuscleUnit]) {
