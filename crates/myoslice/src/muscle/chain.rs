@@ -236,8 +236,13 @@ impl MuscleChain {
     fn refresh_geometry(&mut self, update_wrap: bool) {
         let n = self.x.len().saturating_sub(1);
         self.geom.resize(n, SegmentGeom::default());
-        for i in 0..n {
-            self.refresh_segment(i, update_wrap);
+        // Straight segments in one tight loop (the hot part of every step), then the one
+        // segment that may wrap.
+        for (g, p) in self.geom.iter_mut().zip(self.x.windows(2)) {
+            *g = straight_segment(p[0], p[1]);
+        }
+        if self.wrap.is_some() && self.wrap_segment < n {
+            self.refresh_segment(self.wrap_segment, update_wrap);
         }
     }
 
@@ -261,8 +266,13 @@ impl MuscleChain {
         }
         // Ends and via points are the massless points.
         for i in 0..n - 1 {
-            if self.mass[i] <= 0.0 || self.mass[i + 1] <= 0.0 {
+            if self.mass[i] > 0.0 && self.mass[i + 1] > 0.0 {
+                continue;
+            }
+            if self.wrap.is_some() && i == self.wrap_segment {
                 self.refresh_segment(i, false);
+            } else {
+                self.geom[i] = straight_segment(self.x[i], self.x[i + 1]);
             }
         }
         debug_assert!(
@@ -359,6 +369,7 @@ impl MuscleChain {
 }
 
 /// The straight segment from `a` to `b`.
+#[inline]
 fn straight_segment(a: Vec3, b: Vec3) -> SegmentGeom {
     let d = b - a;
     let l = d.length().max(1e-9);

@@ -56,7 +56,7 @@ pub struct ChainLoad {
 impl MuscleChain {
     /// Tension of segment `i` (N, positive pulling its ends together) and its axial
     /// spring constant (N/m).
-    #[inline]
+    #[inline(always)]
     fn tension(
         &self,
         i: usize,
@@ -246,9 +246,20 @@ impl MuscleChain {
             sc.d[i] = (rhs - sc.d[i - 1] * lower) * inv;
         }
         sc.dv[n - 1] = Vec3::ZERO;
+        let mut sum = Vec3::ZERO;
         for i in (1..n - 1).rev() {
             let v = sc.d[i] - sc.dv[i + 1] * sc.c[i];
-            sc.dv[i] = if v.is_finite() { v } else { Vec3::ZERO };
+            sc.dv[i] = v;
+            sum += v;
+        }
+        // A non-finite change (a degenerate row) is dropped and not passed on to the
+        // points before it. Checked once per chain (a NaN or infinity anywhere makes the
+        // sum non-finite); only then is the substitution redone point by point.
+        if !sum.is_finite() {
+            for i in (1..n - 1).rev() {
+                let v = sc.d[i] - sc.dv[i + 1] * sc.c[i];
+                sc.dv[i] = if v.is_finite() { v } else { Vec3::ZERO };
+            }
         }
     }
 
