@@ -57,6 +57,7 @@ class Simulation:
         body_mass_kg: float = 60.0,
         height_m: float = 1.65,
         muscle_model: str = "hill",
+        tendon: str = "rigid",
         tissue: bool = True,
         tissue_rate_hz: float = 30.0,
         initial_knee_deg: float = 0.0,
@@ -65,7 +66,9 @@ class Simulation:
     ) -> Simulation:
         """The built-in lower-limb phantom (no files needed).
 
-        ``muscle_model`` is ``"hill"`` or ``"spring"``; ``tissue=False`` skips the
+        ``muscle_model`` is ``"hill"`` or ``"spring"``; ``tendon`` is ``"rigid"`` or
+        ``"compliant"`` (the Hill units' tendons stretch, and the fibre length becomes a
+        state found every step); ``tissue=False`` skips the
         deformable fat and muscle volumes (faster; the tissue arrays are then empty).
         """
 
@@ -79,6 +82,7 @@ class Simulation:
         body_mass_kg: float = 60.0,
         height_m: float = 1.65,
         muscle_model: str = "hill",
+        tendon: str = "rigid",
         tissue: bool = True,
         tissue_rate_hz: float = 30.0,
         initial_knee_deg: float = 0.0,

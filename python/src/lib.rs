@@ -52,6 +52,7 @@ fn config(
     body_mass_kg: f64,
     height_m: f64,
     muscle_model: &str,
+    tendon: &str,
     tissue: bool,
     tissue_rate_hz: f64,
     initial_knee_deg: f64,
@@ -68,8 +69,20 @@ fn config(
             ));
         }
     };
+    let tendon = match tendon {
+        "rigid" => TendonModel::Rigid,
+        "compliant" => TendonModel::Compliant,
+        other => {
+            return Err(py_err(
+                py,
+                Kind::Invalid,
+                format!("tendon = '{other}': expected 'rigid' or 'compliant'"),
+            ));
+        }
+    };
     let mut c = SimulationConfig {
         body_mass_kg,
+        tendon,
         height_m,
         muscle_model: model,
         initial_knee_deg,
@@ -99,13 +112,14 @@ fn gpu(py: Python<'_>) -> PyResult<&'static Gpu> {
 impl PySimulation {
     /// The built-in lower-limb phantom (no files needed). Units are SI.
     #[staticmethod]
-    #[pyo3(signature = (*, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tissue = true, tissue_rate_hz = 30.0, initial_knee_deg = 0.0, max_step_s = 0.001, voxel_mm = None))]
+    #[pyo3(signature = (*, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, initial_knee_deg = 0.0, max_step_s = 0.001, voxel_mm = None))]
     #[allow(clippy::too_many_arguments)]
     fn phantom(
         py: Python<'_>,
         body_mass_kg: f64,
         height_m: f64,
         muscle_model: &str,
+        tendon: &str,
         tissue: bool,
         tissue_rate_hz: f64,
         initial_knee_deg: f64,
@@ -117,6 +131,7 @@ impl PySimulation {
             body_mass_kg,
             height_m,
             muscle_model,
+            tendon,
             tissue,
             tissue_rate_hz,
             initial_knee_deg,
@@ -137,7 +152,7 @@ impl PySimulation {
 
     /// A NIfTI label volume with its label table (JSON or TOML).
     #[staticmethod]
-    #[pyo3(signature = (volume, labels, *, slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tissue = true, tissue_rate_hz = 30.0, initial_knee_deg = 0.0, max_step_s = 0.001))]
+    #[pyo3(signature = (volume, labels, *, slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, initial_knee_deg = 0.0, max_step_s = 0.001))]
     #[allow(clippy::too_many_arguments)]
     fn from_nifti(
         py: Python<'_>,
@@ -148,6 +163,7 @@ impl PySimulation {
         body_mass_kg: f64,
         height_m: f64,
         muscle_model: &str,
+        tendon: &str,
         tissue: bool,
         tissue_rate_hz: f64,
         initial_knee_deg: f64,
@@ -160,6 +176,7 @@ impl PySimulation {
             body_mass_kg,
             height_m,
             muscle_model,
+            tendon,
             tissue,
             tissue_rate_hz,
             initial_knee_deg,

@@ -272,6 +272,17 @@ def test_hamstrings_flex_the_knee(rigid: Simulation) -> None:
     assert rigid.knee_angle > 0.5, f"knee at {rigid.knee_angle:.3f} rad after 0.5 s of hamstrings"
 
 
+def test_compliant_tendons_flex_the_knee_and_stretch(rigid: Simulation) -> None:
+    compliant = Simulation.phantom(tissue=False, tendon="compliant")
+    flex(compliant, 0.5)
+    flex(rigid, 0.5)
+    assert compliant.knee_angle > 0.5, f"knee at {compliant.knee_angle:.3f} rad"
+    fibres = compliant.fibre_lengths
+    assert np.all(np.isfinite(fibres))
+    # The loaded tendons take up length the rigid model gives the fibres.
+    assert not np.array_equal(fibres, rigid.fibre_lengths)
+
+
 def test_set_knee(rigid: Simulation) -> None:
     rigid.set_knee(0.8)
     assert rigid.knee_angle == pytest.approx(0.8, abs=1e-6)

@@ -157,6 +157,7 @@ def test_bad_set_knee(rigid: Simulation, angle: float, velocity: float) -> None:
     "kwargs",
     [
         {"muscle_model": "bogus"},
+        {"tendon": "bogus"},
         {"body_mass_kg": -1.0},
         {"height_m": math.nan},
         {"max_step_s": 0.0},

@@ -46,6 +46,6 @@ pub mod prelude {
     pub use crate::lattice::{BuildOptions, Lattice};
     pub use crate::phantom::Phantom;
     pub use crate::scenario::Scenario;
-    pub use crate::simulation::{MuscleModel, Schedule, Simulation, SimulationConfig};
+    pub use crate::simulation::{MuscleModel, Schedule, Simulation, SimulationConfig, TendonModel};
     pub use crate::slices::SliceReduction;
 }

@@ -13,6 +13,7 @@
 //!
 //! [simulation]
 //! muscle_model = "hill"       # or "spring" (the paper's), default hill
+//! tendon = "rigid"            # or "compliant" (Hill units), default rigid
 //! duration_s = 1.0            # required
 //! step_s = 0.001              # default 0.001
 //! initial_knee_deg = 0.0      # default 0
@@ -39,7 +40,7 @@ use serde::Deserialize;
 use crate::error::{Error, Result};
 use crate::lattice::BuildOptions;
 use crate::muscle::MuscleGroup;
-use crate::simulation::{MuscleModel, Schedule, Simulation, SimulationConfig};
+use crate::simulation::{MuscleModel, Schedule, Simulation, SimulationConfig, TendonModel};
 use crate::slices::SliceReduction;
 use crate::tissue::TissueConfig;
 
@@ -110,6 +111,9 @@ pub struct SimulationSection {
     /// Muscle model.
     #[serde(default = "default_model")]
     pub muscle_model: MuscleModel,
+    /// Tendons of the Hill units.
+    #[serde(default)]
+    pub tendon: TendonModel,
     /// Simulated time (s).
     pub duration_s: f64,
     /// Step (s).
@@ -274,6 +278,7 @@ impl Scenario {
             body_mass_kg: self.body.mass_kg,
             height_m: self.body.height_m,
             muscle_model: self.simulation.muscle_model,
+            tendon: self.simulation.tendon,
             initial_knee_deg: self.simulation.initial_knee_deg,
             max_step_s: self.simulation.step_s,
             tissue: self.tissue.clone(),

@@ -128,6 +128,27 @@ impl HillParams {
 
     /// Muscle-tendon force (N, along the tendon) for activation `a` and fibre state.
     pub fn force(&self, a: f64, fibre: &FibreState) -> HillForce {
+        let (l, v, active, fpe) = self.fibre_parts(a, fibre);
+        let fibre_force = self.max_isometric_force * (active + fpe + self.fibre_damping * v);
+        HillForce {
+            tendon: (fibre_force * fibre.cos_pennation).max(0.0),
+            active_fraction: active,
+            passive_fraction: fpe,
+            normalised_length: l,
+            normalised_velocity: v,
+        }
+    }
+
+    /// Fibre force along the fibre, as a fraction of the max isometric force (may be
+    /// negative: the passive curve dips below zero, and damping resists shortening).
+    pub(super) fn fibre_force_fraction(&self, a: f64, fibre: &FibreState) -> f64 {
+        let (_, v, active, fpe) = self.fibre_parts(a, fibre);
+        active + fpe + self.fibre_damping * v
+    }
+
+    /// Normalised length and velocity, the active part `a·f_L·f_V` and `f_PE`.
+    #[inline]
+    fn fibre_parts(&self, a: f64, fibre: &FibreState) -> (f64, f64, f64, f64) {
         let l = fibre.length / self.optimal_fibre_length;
         let v = fibre.velocity / (self.max_contraction_velocity * self.optimal_fibre_length);
         let fpe = passive_force_length(l);
@@ -137,14 +158,7 @@ impl HillParams {
         } else {
             0.0
         };
-        let fibre_force = self.max_isometric_force * (active + fpe + self.fibre_damping * v);
-        HillForce {
-            tendon: (fibre_force * fibre.cos_pennation).max(0.0),
-            active_fraction: active,
-            passive_fraction: fpe,
-            normalised_length: l,
-            normalised_velocity: v,
-        }
+        (l, v, active, fpe)
     }
 }
 

@@ -6,6 +6,7 @@ pub mod dynamics;
 pub mod excursion;
 pub mod hill;
 pub(crate) mod snapshot;
+pub mod tendon;
 pub mod unit;
 pub mod wrap;
 

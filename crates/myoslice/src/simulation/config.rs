@@ -17,6 +17,19 @@ pub enum MuscleModel {
     Spring,
 }
 
+/// How the Hill units' tendons behave.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TendonModel {
+    /// Inextensible: the fibre takes every change of the muscle-tendon length.
+    #[default]
+    Rigid,
+    /// Elastic (De Groote 2016's tendon curve, about 4.7 % strain at max isometric
+    /// force): the fibre length is a state found by backward Euler every step. Costs
+    /// a few microseconds a step more.
+    Compliant,
+}
+
 /// Options of a [`super::Simulation`]. Every field has a documented default.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -27,6 +40,8 @@ pub struct SimulationConfig {
     pub height_m: f64,
     /// Muscle model. Default Hill.
     pub muscle_model: MuscleModel,
+    /// Tendons of the Hill units. Default rigid.
+    pub tendon: TendonModel,
     /// Knee flexion limits (degrees). Default [0, 140].
     pub knee_limits_deg: [f64; 2],
     /// Viscous knee damping (N m s/rad). Default 0.3.
@@ -53,6 +68,7 @@ impl Default for SimulationConfig {
             body_mass_kg: 60.0,
             height_m: 1.65,
             muscle_model: MuscleModel::Hill,
+            tendon: TendonModel::Rigid,
             knee_limits_deg: [0.0, 140.0],
             knee_damping: 0.3,
             gravity: [0.0, 0.0, -9.81],

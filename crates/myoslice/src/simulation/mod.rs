@@ -11,7 +11,7 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
-pub use config::{MuscleModel, SimulationConfig};
+pub use config::{MuscleModel, SimulationConfig, TendonModel};
 pub use schedule::Schedule;
 pub use surface::{Layer, Surface};
 pub use timers::StepTimers;
@@ -220,6 +220,13 @@ impl Simulation {
             m.chain.update_wrap();
             m.path_length = m.chain.path_length();
             m.path_velocity = 0.0;
+            if self.config.tendon == TendonModel::Compliant {
+                // A jump leaves no time for the fibre to move: it starts in equilibrium
+                // with its tendon at the new length.
+                m.fibre =
+                    m.hill
+                        .compliant_tendon_step(m.activation, m.path_length, m.fibre.length, None);
+            }
             if m.crosses_knee {
                 m.moment_arm = m.chain.moment_arm(&axis, BodyId::Shank);
                 m.current_moment_arm = m.moment_arm;

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use glam::Vec3;
 
-use super::{MuscleModel, Simulation};
+use super::{MuscleModel, Simulation, TendonModel};
 use crate::body::BodyId;
 use crate::error::{Error, Result, check_positive};
 use crate::muscle::hill::activation_rate;
@@ -126,6 +126,7 @@ impl Simulation {
         let gravity = self.skeleton.gravity();
         let knee = *self.skeleton.knee();
         let hill = self.config.muscle_model == MuscleModel::Hill;
+        let compliant = self.config.tendon == TendonModel::Compliant;
         let (mut forces, mut loads) = std::mem::take(&mut self.scratch);
         forces.clear();
         loads.clear();
@@ -155,9 +156,17 @@ impl Simulation {
                 continue;
             }
             let (tension, ends) = if hill {
-                m.fibre = m
-                    .hill
-                    .rigid_tendon_kinematics(m.path_length, m.path_velocity);
+                m.fibre = if compliant {
+                    m.hill.compliant_tendon_step(
+                        m.activation,
+                        m.path_length,
+                        m.fibre.length,
+                        Some(h),
+                    )
+                } else {
+                    m.hill
+                        .rigid_tendon_kinematics(m.path_length, m.path_velocity)
+                };
                 let f = m.hill.force(m.activation, &m.fibre);
                 m.force = f.tendon;
                 (f.tendon as f32, None)

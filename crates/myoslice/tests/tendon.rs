@@ -1,0 +1,192 @@
+//! The compliant tendon: its backward-Euler solve, its stretch under load, and a
+//! simulation driven by units with elastic tendons.
+
+#![allow(clippy::unwrap_used)] // tests fail loudly by design
+
+use std::sync::OnceLock;
+
+use myoslice::muscle::hill::tendon_force_length;
+use myoslice::muscle::{HillParams, MuscleCatalogue};
+use myoslice::prelude::*;
+
+const HAMSTRINGS: [&str; 4] = [
+    "semitendinosus",
+    "semimembranosus",
+    "biceps_femoris_long",
+    "biceps_femoris_short",
+];
+
+fn lattice() -> &'static Lattice {
+    static L: OnceLock<Lattice> = OnceLock::new();
+    L.get_or_init(|| {
+        let (v, t) = Phantom::default().generate().unwrap();
+        Lattice::build(&v, &t, &BuildOptions::default()).unwrap()
+    })
+}
+
+fn sim(tendon: TendonModel) -> Simulation {
+    let mut c = SimulationConfig {
+        tendon,
+        ..SimulationConfig::default()
+    };
+    c.tissue.enabled = false;
+    Simulation::new(lattice().clone(), c, &MuscleCatalogue::default()).unwrap()
+}
+
+/// A pennate unit with a long tendon (semitendinosus-like proportions).
+fn unit() -> HillParams {
+    HillParams::new(1000.0, 0.1, 0.25, 0.2, 10.0)
+}
+
+#[test]
+fn a_compliant_tendon_pulls_exactly_as_hard_as_its_fibre_after_every_step() {
+    let p = unit();
+    let fmax = p.max_isometric_force;
+    // Activation, muscle-tendon length, previous fibre length, step: shortening,
+    // lengthening, isometric, inactive, slack and stretched units, small and large steps.
+    let cases = [
+        (1.0, 0.36, 0.10, 1e-3),
+        (1.0, 0.36, 0.12, 1e-3),
+        (0.5, 0.34, 0.09, 1e-3),
+        (0.0, 0.36, 0.10, 1e-3),
+        (0.0, 0.30, 0.10, 1e-3),
+        (0.2, 0.40, 0.14, 1e-4),
+        (1.0, 0.33, 0.05, 1e-2),
+        (0.8, 0.50, 0.10, 1e-3),
+    ];
+    for (a, l_mt, prev, h) in cases {
+        let f = p.compliant_tendon_step(a, l_mt, prev, Some(h));
+        assert!(f.length.is_finite() && f.length > 0.0, "{f:?}");
+        let tendon = p.tendon_force(l_mt - f.length * f.cos_pennation);
+        let fibre = p.force(a, &f).tendon;
+        assert!(
+            (tendon - fibre).abs() <= 1e-6 * fmax,
+            "a {a}, l_mt {l_mt}, prev {prev}: tendon {tendon} N, fibre {fibre} N"
+        );
+        assert!(((f.length - prev) / h - f.velocity).abs() <= 1e-9 * f.velocity.abs().max(1.0));
+    }
+}
+
+#[test]
+fn a_held_active_unit_settles_at_optimal_fibre_length_with_its_tendon_stretched() {
+    // Held at the length where a fully active fibre at optimal length balances its tendon;
+    // started with the fibre 20 % short, it lengthens (stretching the tendon less) until
+    // it settles there, pulling F_max along the fibre.
+    let p = unit();
+    let cos_a = p.pennation.cos();
+    // De Groote's tendon curve reaches F_max·cos α at this normalised length.
+    let l_t = 0.995 + ((cos_a + 0.25) / 0.2).ln() / 35.0;
+    assert!((tendon_force_length(l_t) - cos_a).abs() < 1e-12);
+    let l_mt = p.optimal_fibre_length * cos_a + p.tendon_slack_length * l_t;
+    let mut fibre = 0.08;
+    let mut state = None;
+    for _ in 0..2000 {
+        let f = p.compliant_tendon_step(1.0, l_mt, fibre, Some(1e-3));
+        fibre = f.length;
+        state = Some(f);
+    }
+    let f = state.unwrap();
+    let force = p.force(1.0, &f).tendon;
+    let strain = (l_mt - f.length * f.cos_pennation) / p.tendon_slack_length - 1.0;
+    assert!(
+        (f.length / p.optimal_fibre_length - 1.0).abs() < 0.01,
+        "fibre at {:.4} of optimal",
+        f.length / p.optimal_fibre_length
+    );
+    assert!(
+        (force / (p.max_isometric_force * cos_a) - 1.0).abs() < 0.01,
+        "{force} N"
+    );
+    // About 4.7 % at F_max (De Groote 2016's curve; Zajac 1989 gives 3.3 %).
+    assert!((0.04..0.05).contains(&strain), "tendon strain {strain}");
+    assert!(
+        f.velocity.abs() < 1e-6,
+        "still moving at {} m/s",
+        f.velocity
+    );
+}
+
+#[test]
+fn the_static_equilibrium_needs_no_fibre_velocity() {
+    let p = unit();
+    for (a, l_mt) in [(1.0, 0.36), (0.3, 0.35), (0.0, 0.37), (0.0, 0.30)] {
+        let f = p.compliant_tendon_step(a, l_mt, 0.1, None);
+        assert_eq!(f.velocity, 0.0);
+        let tendon = p.tendon_force(l_mt - f.length * f.cos_pennation);
+        assert!((tendon - p.force(a, &f).tendon).abs() <= 1e-6 * p.max_isometric_force);
+    }
+}
+
+#[test]
+fn knee_flexes_past_60_degrees_within_a_second_with_compliant_tendons() {
+    let mut s = sim(TendonModel::Compliant);
+    let rigid = sim(TendonModel::Rigid);
+    // Built at rest: tendons at their zero-force length, fibres where the rigid model
+    // puts them.
+    for (m, r) in s.muscles().iter().zip(rigid.muscles()) {
+        let rel = (m.fibre.length - r.fibre.length).abs() / r.fibre.length;
+        assert!(
+            rel < 0.02,
+            "{}: fibre {} vs {}",
+            m.name,
+            m.fibre.length,
+            r.fibre.length
+        );
+    }
+    for m in HAMSTRINGS {
+        s.set_excitation(m, 1.0).unwrap();
+    }
+    let mut reached = None;
+    let mut stretched = false;
+    let mut max_strain: f64 = 0.0;
+    let [lo, hi] = [0.0, 140f64.to_radians()];
+    for k in 0..100 {
+        s.step(0.01).unwrap();
+        let a = s.knee_angle();
+        assert!((lo - 1e-3..=hi + 1e-3).contains(&a), "knee at {a} rad");
+        if reached.is_none() && a > 60f64.to_radians() {
+            reached = Some(0.01 * (k + 1) as f64);
+        }
+        let m = s.muscle("semitendinosus").unwrap();
+        let i = s.muscle_index("semitendinosus").unwrap();
+        let u = &s.muscles()[i];
+        let tendon = m.path_length - u.fibre.length * u.fibre.cos_pennation;
+        if m.force > 100.0 && tendon > u.hill.tendon_slack_length * 1.002 {
+            stretched = true;
+        }
+        max_strain = max_strain.max(tendon / u.hill.tendon_slack_length - 1.0);
+    }
+    println!(
+        "compliant: knee {:.1}° at 1 s, semitendinosus tendon strain up to {:.2} %",
+        s.knee_angle().to_degrees(),
+        100.0 * max_strain
+    );
+    assert!(
+        reached.is_some_and(|t| t <= 1.0),
+        "knee at {:.1}° after 1 s",
+        s.knee_angle().to_degrees()
+    );
+    assert!(
+        stretched,
+        "the loaded semitendinosus tendon never stretched"
+    );
+}
+
+#[test]
+fn compliant_stepping_is_deterministic() {
+    let run = || {
+        let mut s = sim(TendonModel::Compliant);
+        for m in HAMSTRINGS {
+            s.set_excitation(m, 0.7).unwrap();
+        }
+        s.step(0.3).unwrap();
+        (
+            s.knee_angle().to_bits(),
+            s.muscles()
+                .iter()
+                .map(|m| m.fibre.length.to_bits())
+                .collect::<Vec<_>>(),
+        )
+    };
+    assert_eq!(run(), run());
+}
