@@ -25,8 +25,7 @@ pub enum TendonModel {
     #[default]
     Rigid,
     /// Elastic (De Groote 2016's tendon curve, about 4.7 % strain at max isometric
-    /// force): the fibre length is a state found by backward Euler every step. Costs
-    /// a few microseconds a step more.
+    /// force): the fibre length is a state found by backward Euler every step.
     Compliant,
 }
 

@@ -220,9 +220,11 @@ impl Simulation {
             m.chain.update_wrap();
             m.path_length = m.chain.path_length();
             m.path_velocity = 0.0;
-            if self.config.tendon == TendonModel::Compliant {
-                // A jump leaves no time for the fibre to move: it starts in equilibrium
-                // with its tendon at the new length.
+            if self.config.tendon == TendonModel::Compliant
+                && self.config.muscle_model == MuscleModel::Hill
+            {
+                // After a jump the fibre starts in static equilibrium with its tendon at
+                // the new length (a step across the jump would read it as a huge velocity).
                 m.fibre =
                     m.hill
                         .compliant_tendon_step(m.activation, m.path_length, m.fibre.length, None);
