@@ -61,7 +61,7 @@ impl HillParams {
         }
         let prev_x = (prev * prev - height * height).max(0.0).sqrt();
         let mut x = prev_x.clamp(lo, hi);
-        let r = residual(x);
+        let mut r = residual(x);
         if r == 0.0 {
             return state(x); // slack: nothing pulls
         }
@@ -81,12 +81,15 @@ impl HillParams {
         // would leave the bracket.
         let dx = 1e-7 * self.optimal_fibre_length;
         let tol = 1e-10 * self.optimal_fibre_length;
-        for _ in 0..MAX_ITERATIONS {
-            let r = residual(x);
-            if r > 0.0 {
-                lo = x;
-            } else {
-                hi = x;
+        for k in 0..MAX_ITERATIONS {
+            // The first pass reuses the residual that set up the bracket.
+            if k > 0 {
+                r = residual(x);
+                if r > 0.0 {
+                    lo = x;
+                } else {
+                    hi = x;
+                }
             }
             let slope = (residual(x + dx) - r) / dx;
             let newton = x - r / slope;
