@@ -127,6 +127,20 @@ class Simulation:
         """Control group of each muscle: ``"flexor"``, ``"extensor"`` or ``"other"``."""
 
     @property
+    def muscle_model(self) -> str:
+        """The muscle model, ``"hill"`` or ``"spring"``. Settable mid-run: the pose,
+        chains and activations carry over."""
+
+    @muscle_model.setter
+    def muscle_model(self, value: str) -> None: ...
+    @property
+    def tendon(self) -> str:
+        """The Hill units' tendons, ``"rigid"`` or ``"compliant"``. Settable mid-run:
+        a compliant fibre starts in static equilibrium with its tendon."""
+
+    @tendon.setter
+    def tendon(self, value: str) -> None: ...
+    @property
     def time(self) -> float:
         """Simulated time (s)."""
 
@@ -200,7 +214,7 @@ class Simulation:
         """Puts the knee at ``angle`` (rad) with flexion ``velocity`` (rad/s)."""
 
     def state(self) -> State:
-        """A checkpoint of the whole dynamic state."""
+        """A checkpoint of the whole dynamic state, the muscle and tendon models included."""
 
     def set_state(self, state: State) -> None:
         """Restores a checkpoint taken from this simulation."""

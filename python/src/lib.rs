@@ -58,28 +58,8 @@ fn config(
     initial_knee_deg: f64,
     max_step_s: f64,
 ) -> PyResult<SimulationConfig> {
-    let model = match muscle_model {
-        "hill" => MuscleModel::Hill,
-        "spring" => MuscleModel::Spring,
-        other => {
-            return Err(py_err(
-                py,
-                Kind::Invalid,
-                format!("muscle_model = '{other}': expected 'hill' or 'spring'"),
-            ));
-        }
-    };
-    let tendon = match tendon {
-        "rigid" => TendonModel::Rigid,
-        "compliant" => TendonModel::Compliant,
-        other => {
-            return Err(py_err(
-                py,
-                Kind::Invalid,
-                format!("tendon = '{other}': expected 'rigid' or 'compliant'"),
-            ));
-        }
-    };
+    let model: MuscleModel = muscle_model.parse().or_py(py)?;
+    let tendon: TendonModel = tendon.parse().or_py(py)?;
     let mut c = SimulationConfig {
         body_mass_kg,
         tendon,
@@ -363,6 +343,31 @@ impl PySimulation {
             .collect()
     }
 
+    /// The muscle model, "hill" or "spring"; settable mid-run.
+    #[getter]
+    fn muscle_model(&self) -> &'static str {
+        self.sim.muscle_model().name()
+    }
+
+    #[setter]
+    fn set_muscle_model(&mut self, py: Python<'_>, value: &str) -> PyResult<()> {
+        self.sim.set_muscle_model(value.parse().or_py(py)?);
+        Ok(())
+    }
+
+    /// The Hill units' tendons, "rigid" or "compliant"; settable mid-run (a compliant
+    /// fibre starts in static equilibrium with its tendon).
+    #[getter]
+    fn tendon(&self) -> &'static str {
+        self.sim.tendon_model().name()
+    }
+
+    #[setter]
+    fn set_tendon(&mut self, py: Python<'_>, value: &str) -> PyResult<()> {
+        self.sim.set_tendon_model(value.parse().or_py(py)?);
+        Ok(())
+    }
+
     /// Simulated time (s).
     #[getter]
     fn time(&self) -> f64 {
@@ -487,7 +492,7 @@ impl PySimulation {
         self.sim.set_knee(angle, velocity).or_py(py)
     }
 
-    /// A checkpoint of the whole dynamic state.
+    /// A checkpoint of the whole dynamic state, the muscle and tendon models included.
     fn state(&self) -> PyState {
         PyState {
             inner: self.sim.state(),

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import myoslice
-from myoslice import Simulation, State
+from myoslice import InvalidInputError, Simulation, State
 
 HAMSTRINGS = ("semitendinosus", "semimembranosus", "biceps_femoris_long", "biceps_femoris_short")
 PER_MUSCLE_F64 = ("excitations", "activations", "forces", "fibre_lengths", "moment_arms")
@@ -281,6 +281,27 @@ def test_compliant_tendons_flex_the_knee_and_stretch(rigid: Simulation) -> None:
     assert np.all(np.isfinite(fibres))
     # The loaded tendons take up length the rigid model gives the fibres.
     assert not np.array_equal(fibres, rigid.fibre_lengths)
+
+
+def test_models_switch_on_a_running_simulation(rigid: Simulation) -> None:
+    assert (rigid.muscle_model, rigid.tendon) == ("hill", "rigid")
+    flex(rigid, 0.2)
+    angle, fibres = rigid.knee_angle, rigid.fibre_lengths
+    rigid.tendon = "compliant"
+    assert rigid.tendon == "compliant"
+    # The pose stays; the loaded fibres give the tendons their stretch at once.
+    assert rigid.knee_angle == angle
+    assert not np.array_equal(rigid.fibre_lengths, fibres)
+    rigid.muscle_model = "spring"
+    assert rigid.muscle_model == "spring"
+    rigid.step(0.001, n=50)
+    assert math.isfinite(rigid.knee_angle)
+    with pytest.raises(InvalidInputError, match="tendon"):
+        rigid.tendon = "elastic"
+    with pytest.raises(InvalidInputError, match="muscle_model"):
+        rigid.muscle_model = "hil"
+    # A refused value changes nothing.
+    assert (rigid.muscle_model, rigid.tendon) == ("spring", "compliant")
 
 
 def test_set_knee(rigid: Simulation) -> None:

@@ -6,6 +6,8 @@ pub mod capture;
 pub mod colormap;
 pub mod gpu;
 pub mod model;
+#[cfg(feature = "window")]
+pub mod model_switch;
 pub mod pick;
 pub mod render;
 pub mod scene;

@@ -62,13 +62,11 @@ fn fat_case(
 
 fn knee_case(
     name: &'static str,
-    tissue: bool,
+    cfg: SimulationConfig,
     muscles: &[&str],
     note: &str,
     runs: usize,
 ) -> Result<Case> {
-    let mut cfg = SimulationConfig::default();
-    cfg.tissue.enabled = tissue;
     let base = Simulation::phantom(cfg)?;
     let (t, angle) = best_of(runs, || {
         let mut s = base.clone();
@@ -147,12 +145,26 @@ pub fn run(o: &BenchOptions) -> Result<()> {
         "popliteus",
         "plantaris",
     ];
+    let mut muscles_only = SimulationConfig::default();
+    muscles_only.tissue.enabled = false;
     if wanted("knee_hinge_16") {
         cases.push(knee_case(
             "knee_hinge_16",
-            false,
+            muscles_only.clone(),
             &FLEXORS,
             "all muscles, the 10 flexors excited at 0.6, Hill, 1 ms, no tissue",
+            runs,
+        )?);
+    }
+    if wanted("knee_hinge_16_compliant") {
+        cases.push(knee_case(
+            "knee_hinge_16_compliant",
+            SimulationConfig {
+                tendon: TendonModel::Compliant,
+                ..muscles_only
+            },
+            &FLEXORS,
+            "as knee_hinge_16 with compliant tendons",
             runs,
         )?);
     }
@@ -168,7 +180,7 @@ pub fn run(o: &BenchOptions) -> Result<()> {
     if wanted("whole_leg_step") {
         cases.push(knee_case(
             "whole_leg_step",
-            true,
+            SimulationConfig::default(),
             &FLEXORS,
             "all muscles, tissue at 30 Hz x 6 iterations, 1 ms",
             runs,
@@ -177,7 +189,7 @@ pub fn run(o: &BenchOptions) -> Result<()> {
     if cases.is_empty() {
         anyhow::bail!(
             "no benchmark case matches '{}' (cases: build_phantom, build_visible_human, \
-             knee_hinge_16, fat_kernel_840, fat_kernel_20k, fat_kernel_200k, whole_leg_step)",
+             knee_hinge_16, knee_hinge_16_compliant, fat_kernel_840, fat_kernel_20k, fat_kernel_200k, whole_leg_step)",
             o.only.unwrap_or_default()
         );
     }

@@ -1,6 +1,7 @@
-//! Stepping: the muscle + skeleton step alone (Hill, 1 ms) and the whole leg with its
-//! tissue at the default rate. Each sample runs 0.1 s of simulated time from the same
-//! state, a flexion under way, so the real-time factor is 0.1 s over the time shown.
+//! Stepping: the muscle + skeleton step alone (Hill, 1 ms; rigid tendons, and compliant
+//! ones on the phantom) and the whole leg with its tissue at the default rate. Each
+//! sample runs 0.1 s of simulated time from the same state, a flexion under way, so the
+//! real-time factor is 0.1 s over the time shown.
 
 mod common;
 
@@ -13,7 +14,14 @@ use myoslice::prelude::*;
 const SPAN_S: f64 = 0.1;
 
 fn flexing(lattice: Lattice, tissue: bool) -> Simulation {
-    let mut cfg = SimulationConfig::default();
+    flexing_with(lattice, tissue, TendonModel::Rigid)
+}
+
+fn flexing_with(lattice: Lattice, tissue: bool, tendon: TendonModel) -> Simulation {
+    let mut cfg = SimulationConfig {
+        tendon,
+        ..SimulationConfig::default()
+    };
     cfg.tissue.enabled = tissue;
     let mut sim = Simulation::new(lattice, cfg, &MuscleCatalogue::default())
         .unwrap_or_else(|e| panic!("{e}"));
@@ -56,6 +64,14 @@ fn steps(c: &mut Criterion) {
             1,
         );
     }
+    // The same with the compliant tendons' per-step solve.
+    bench_span(
+        c,
+        "muscle_step_0.1s",
+        "phantom_compliant",
+        &flexing_with(phantom.clone(), false, TendonModel::Compliant),
+        1,
+    );
     for threads in [1, 2] {
         bench_span(
             c,

@@ -2,7 +2,7 @@
 
 #![allow(clippy::unwrap_used)] // tests fail loudly by design
 
-use std::sync::OnceLock;
+mod common;
 
 use glam::Quat;
 use myoslice::body::{Skeleton, SkeletonOptions, knee_axis};
@@ -12,26 +12,14 @@ use myoslice::muscle::hill::{
 use myoslice::muscle::{MuscleCatalogue, MuscleGroup};
 use myoslice::prelude::*;
 
-const HAMSTRINGS: [&str; 4] = [
-    "semitendinosus",
-    "semimembranosus",
-    "biceps_femoris_long",
-    "biceps_femoris_short",
-];
+use common::{HAMSTRINGS, phantom_lattice};
+
 const QUADRICEPS: [&str; 4] = [
     "rectus_femoris",
     "vastus_lateralis",
     "vastus_medialis",
     "vastus_intermedius",
 ];
-
-fn lattice() -> &'static Lattice {
-    static L: OnceLock<Lattice> = OnceLock::new();
-    L.get_or_init(|| {
-        let (v, t) = Phantom::default().generate().unwrap();
-        Lattice::build(&v, &t, &BuildOptions::default()).unwrap()
-    })
-}
 
 fn config() -> SimulationConfig {
     let mut c = SimulationConfig::default();
@@ -40,12 +28,12 @@ fn config() -> SimulationConfig {
 }
 
 fn sim(c: SimulationConfig) -> Simulation {
-    Simulation::new(lattice().clone(), c, &MuscleCatalogue::default()).unwrap()
+    Simulation::new(phantom_lattice().clone(), c, &MuscleCatalogue::default()).unwrap()
 }
 
 #[test]
 fn passive_shank_swings_with_the_compound_pendulum_period_and_keeps_its_energy() {
-    let lat = lattice();
+    let lat = phantom_lattice();
     let knee = knee_axis(lat.bone("femur").unwrap()).unwrap();
     // Gravity along the shank at 60° of flexion: the shank hangs there, clear of limits.
     let probe = Skeleton::new(
@@ -458,7 +446,7 @@ fn bad_input_gets_clear_errors() {
     assert!(s.step(f64::NAN).is_err());
     assert!(s.set_excitations(&[0.1, 0.2]).is_err());
     let e = Simulation::new(
-        lattice().clone(),
+        phantom_lattice().clone(),
         SimulationConfig {
             body_mass_kg: -3.0,
             ..config()
@@ -477,7 +465,7 @@ fn a_simulation_that_blows_up_stops_with_an_error_and_keeps_the_last_good_state(
         .get_mut("vastus_intermedius")
         .unwrap()
         .max_isometric_force_n = Some(1e30);
-    let mut s = Simulation::new(lattice().clone(), config(), &cat).unwrap();
+    let mut s = Simulation::new(phantom_lattice().clone(), config(), &cat).unwrap();
     s.step(0.01).unwrap();
     let (t, a) = (s.time(), s.knee_angle());
     s.set_excitation("vastus_intermedius", 1.0).unwrap();
@@ -498,7 +486,7 @@ fn a_failed_call_leaves_no_trace_in_what_follows() {
         .unwrap()
         .max_isometric_force_n = Some(3e6);
     let start = || {
-        let mut s = Simulation::new(lattice().clone(), config(), &cat).unwrap();
+        let mut s = Simulation::new(phantom_lattice().clone(), config(), &cat).unwrap();
         // A short extensor: no passive force from its huge strength until it is excited.
         s.set_excitation("semimembranosus", 0.8).unwrap();
         s.step(0.05).unwrap();

@@ -3,26 +3,13 @@
 
 #![allow(clippy::unwrap_used)] // tests fail loudly by design
 
-use std::sync::OnceLock;
+mod common;
 
 use myoslice::muscle::hill::tendon_force_length;
 use myoslice::muscle::{HillParams, MuscleCatalogue};
 use myoslice::prelude::*;
 
-const HAMSTRINGS: [&str; 4] = [
-    "semitendinosus",
-    "semimembranosus",
-    "biceps_femoris_long",
-    "biceps_femoris_short",
-];
-
-fn lattice() -> &'static Lattice {
-    static L: OnceLock<Lattice> = OnceLock::new();
-    L.get_or_init(|| {
-        let (v, t) = Phantom::default().generate().unwrap();
-        Lattice::build(&v, &t, &BuildOptions::default()).unwrap()
-    })
-}
+use common::{HAMSTRINGS, phantom_lattice};
 
 fn sim(tendon: TendonModel) -> Simulation {
     let mut c = SimulationConfig {
@@ -30,7 +17,7 @@ fn sim(tendon: TendonModel) -> Simulation {
         ..SimulationConfig::default()
     };
     c.tissue.enabled = false;
-    Simulation::new(lattice().clone(), c, &MuscleCatalogue::default()).unwrap()
+    Simulation::new(phantom_lattice().clone(), c, &MuscleCatalogue::default()).unwrap()
 }
 
 /// A pennate unit with a long tendon (semitendinosus-like proportions).
@@ -189,4 +176,87 @@ fn compliant_stepping_is_deterministic() {
         )
     };
     assert_eq!(run(), run());
+}
+
+#[test]
+fn switching_tendons_mid_run_starts_each_fibre_where_the_new_model_puts_it() {
+    let mut s = sim(TendonModel::Rigid);
+    for m in HAMSTRINGS {
+        s.set_excitation(m, 0.8).unwrap();
+    }
+    s.step(0.3).unwrap();
+    assert_eq!(s.tendon_model(), TendonModel::Rigid);
+    let mut unswitched = s.clone();
+    let (checkpoint, mut reference) = (s.state(), s.clone());
+    s.set_tendon_model(TendonModel::Compliant);
+    assert_eq!(s.tendon_model(), TendonModel::Compliant);
+    // In static equilibrium at once: tendon force equals fibre force along it.
+    for u in s.muscles() {
+        let f = u.hill.force(u.activation, &u.fibre);
+        let tendon = u
+            .hill
+            .tendon_force(u.path_length - u.fibre.length * u.fibre.cos_pennation);
+        assert!(
+            (tendon - f.tendon).abs() <= 1e-6 * u.hill.max_isometric_force,
+            "{}: tendon {tendon} N vs fibre {} N",
+            u.name,
+            f.tendon
+        );
+    }
+    // The stretched tendons of the loaded hamstrings leave their fibres shorter.
+    let i = s.muscle_index("semitendinosus").unwrap();
+    let rigid_fibre = s.muscles()[i]
+        .hill
+        .rigid_tendon_kinematics(s.muscles()[i].path_length, 0.0)
+        .length;
+    assert!(s.muscles()[i].fibre.length < rigid_fibre);
+    // The motion goes on from the same pose: over the next 50 ms the knee stays within
+    // a few degrees of a run that kept its rigid tendons (the stretching tendons make it
+    // flex about a degree slower).
+    unswitched.step(0.05).unwrap();
+    s.step(0.05).unwrap();
+    let gap = (s.knee_angle() - unswitched.knee_angle()).to_degrees();
+    assert!(gap.abs() < 3.0, "the switched knee is {gap:.2}° off");
+    // And back: the fibre takes the whole path again.
+    s.set_tendon_model(TendonModel::Rigid);
+    let u = &s.muscles()[i];
+    assert_eq!(
+        u.fibre.length,
+        u.hill
+            .rigid_tendon_kinematics(u.path_length, u.path_velocity)
+            .length
+    );
+    // Switching the muscle model keeps the pose and steps on.
+    let angle = s.knee_angle();
+    s.set_muscle_model(MuscleModel::Spring);
+    assert_eq!(s.muscle_model(), MuscleModel::Spring);
+    assert_eq!(s.knee_angle(), angle);
+    s.step(0.1).unwrap();
+    assert!(s.knee_angle().is_finite());
+    // A checkpoint carries its models: restored, it replays the unswitched run exactly.
+    s.set_state(&checkpoint).unwrap();
+    assert_eq!(
+        (s.muscle_model(), s.tendon_model()),
+        (MuscleModel::Hill, TendonModel::Rigid)
+    );
+    s.step(0.05).unwrap();
+    reference.step(0.05).unwrap();
+    assert_eq!(s.knee_angle().to_bits(), reference.knee_angle().to_bits());
+}
+
+#[test]
+fn model_names_parse_back_and_unknown_ones_are_named_in_the_error() {
+    for m in MuscleModel::ALL {
+        assert_eq!(m.name().parse::<MuscleModel>().unwrap(), m);
+    }
+    for t in TendonModel::ALL {
+        assert_eq!(t.name().parse::<TendonModel>().unwrap(), t);
+    }
+    let e = "springy".parse::<MuscleModel>().unwrap_err().to_string();
+    assert!(
+        e.contains("muscle_model") && e.contains("'springy'") && e.contains("'hill'"),
+        "{e}"
+    );
+    let e = "elastic".parse::<TendonModel>().unwrap_err().to_string();
+    assert!(e.contains("tendon") && e.contains("'compliant'"), "{e}");
 }

@@ -10,11 +10,6 @@ use myoslice::prelude::*;
 use myoslice::tissue::intersect::self_intersections;
 use myoslice::tissue::{Tissue, TissueMetrics, bone_surfaces};
 
-fn phantom_lattice() -> Lattice {
-    let (v, t) = Phantom::default().generate().unwrap();
-    Lattice::build(&v, &t, &BuildOptions::default()).unwrap()
-}
-
 /// A fresh tissue of a simulation (its own copy, to move by hand).
 fn tissue_of(sim: &Simulation) -> Tissue {
     let lat = sim.lattice();
@@ -168,7 +163,7 @@ fn muscle_volumes_stay_within_one_percent(lattice: Lattice) {
 
 #[test]
 fn muscle_volume_is_conserved_through_a_deep_flexion_of_the_phantom() {
-    muscle_volumes_stay_within_one_percent(phantom_lattice());
+    muscle_volumes_stay_within_one_percent(common::phantom_lattice().clone());
 }
 
 #[test]
@@ -258,7 +253,12 @@ fn blowing_up_phantom() -> Simulation {
         .get_mut("vastus_intermedius")
         .unwrap()
         .max_isometric_force_n = Some(3e6);
-    Simulation::new(phantom_lattice(), SimulationConfig::default(), &cat).unwrap()
+    Simulation::new(
+        common::phantom_lattice().clone(),
+        SimulationConfig::default(),
+        &cat,
+    )
+    .unwrap()
 }
 
 #[test]

@@ -57,6 +57,36 @@ pub fn force_velocity(v: f64) -> f64 {
     D1 * (x + (x * x + 1.0).sqrt()).ln() + D4
 }
 
+/// [`active_force_length`] and its slope d/dl, from one exponential per term.
+pub fn active_force_length_and_slope(l: f64) -> (f64, f64) {
+    FL.iter().fold((0.0, 0.0), |(f, df), b| {
+        let den = b[2] + b[3] * l;
+        let u = (l - b[1]) / den;
+        let e = b[0] * (-0.5 * u * u).exp();
+        // d/dl of −u²/2, with u' = (den − (l − b1)·b3) / den² = (1 − u·b3) / den.
+        (f + e, df - e * u * (1.0 - u * b[3]) / den)
+    })
+}
+
+/// [`passive_force_length`] and its slope d/dl.
+pub fn passive_force_length_and_slope(l: f64) -> (f64, f64) {
+    let e = (K_PE * (l - 1.0) / E0).exp();
+    ((e - 1.0) / PASSIVE_SCALE, K_PE / E0 * e / PASSIVE_SCALE)
+}
+
+/// [`force_velocity`] and its slope d/dv.
+pub fn force_velocity_and_slope(v: f64) -> (f64, f64) {
+    let x = D2 * v + D3;
+    let r = (x * x + 1.0).sqrt();
+    (D1 * (x + r).ln() + D4, D1 * D2 / r)
+}
+
+/// [`tendon_force_length`] and its slope d/dl.
+pub fn tendon_force_length_and_slope(l: f64) -> (f64, f64) {
+    let e = C1 * (K_T * (l - C2)).exp();
+    (e - C3, K_T * e)
+}
+
 /// Inverse of [`force_velocity`]: normalised velocity at which the multiplier is `f`.
 pub fn force_velocity_inverse(f: f64) -> f64 {
     (((f - D4) / D1).sinh() - D3) / D2
@@ -139,13 +169,6 @@ impl HillParams {
         }
     }
 
-    /// Fibre force along the fibre, as a fraction of the max isometric force (may be
-    /// negative: the passive curve dips below zero, and damping resists shortening).
-    pub(super) fn fibre_force_fraction(&self, a: f64, fibre: &FibreState) -> f64 {
-        let (_, v, active, fpe) = self.fibre_parts(a, fibre);
-        active + fpe + self.fibre_damping * v
-    }
-
     /// Normalised length and velocity, the active part `a·f_L·f_V` and `f_PE`.
     #[inline]
     fn fibre_parts(&self, a: f64, fibre: &FibreState) -> (f64, f64, f64, f64) {
@@ -195,6 +218,46 @@ mod tests {
     #[test]
     fn the_passive_normaliser_is_exp_k_pe_minus_one() {
         assert!((PASSIVE_SCALE - (K_PE.exp() - 1.0)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn each_curve_and_slope_pair_matches_the_curve_and_its_finite_difference() {
+        type Pair = fn(f64) -> (f64, f64);
+        type Curve = fn(f64) -> f64;
+        let pairs: [(Pair, Curve, [f64; 2]); 4] = [
+            (
+                active_force_length_and_slope,
+                active_force_length,
+                [0.3, 1.8],
+            ),
+            (
+                passive_force_length_and_slope,
+                passive_force_length,
+                [0.5, 1.8],
+            ),
+            (force_velocity_and_slope, force_velocity, [-1.0, 1.0]),
+            (
+                tendon_force_length_and_slope,
+                tendon_force_length,
+                [0.95, 1.1],
+            ),
+        ];
+        for (pair, curve, [lo, hi]) in pairs {
+            for k in 0..=40 {
+                let x = lo + (hi - lo) * f64::from(k) / 40.0;
+                let (f, df) = pair(x);
+                assert!(
+                    (f - curve(x)).abs() <= 1e-12 * (1.0 + f.abs()),
+                    "value at {x}"
+                );
+                let d = 1e-6;
+                let fd = (curve(x + d) - curve(x - d)) / (2.0 * d);
+                assert!(
+                    (df - fd).abs() <= 1e-6 * (1.0 + fd.abs()),
+                    "slope at {x}: {df} vs {fd}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -3,7 +3,10 @@
 //! fibre leaves of the muscle-tendon length, pulls exactly as hard as the fibre does along
 //! it at the velocity that length implies.
 
-use super::hill::{FibreState, HillParams, tendon_force_length};
+use super::hill::{
+    FibreState, HillParams, active_force_length_and_slope, force_velocity_and_slope,
+    passive_force_length_and_slope, tendon_force_length, tendon_force_length_and_slope,
+};
 
 /// Iterations of the safeguarded Newton solve; it converges in a handful.
 const MAX_ITERATIONS: usize = 60;
@@ -48,62 +51,145 @@ impl HillParams {
                 velocity: h.map_or(0.0, |h| (length - prev) / h),
             }
         };
-        // Tendon pull minus fibre pull along the tendon (De Groote's passive curve dips
-        // below zero short of optimal length: a fibre never pushes). Never rises with x.
-        let residual = |x: f64| {
-            let s = state(x);
-            let fibre = self.max_isometric_force * self.fibre_force_fraction(a, &s).max(0.0);
-            self.tendon_force(l_mt - x) - fibre * s.cos_pennation
-        };
+        let residual = |x: f64| self.balance(a, l_mt, prev, h, x);
         let (mut lo, mut hi) = (1e-4 * self.optimal_fibre_length, l_mt);
         if l_mt.is_nan() || hi <= lo {
             return state(lo);
         }
         let prev_x = (prev * prev - height * height).max(0.0).sqrt();
         let mut x = prev_x.clamp(lo, hi);
-        let mut r = residual(x);
+        let (mut r, mut slope) = residual(x);
         if r == 0.0 {
             return state(x); // slack: nothing pulls
         }
-        // Bracket [lo, hi] with residual > 0 at lo and ≤ 0 at hi. At hi = l_mt the tendon
-        // has no length left and cannot pull.
-        if r > 0.0 {
+        // Bracket [lo, hi] with residual ≤ 0 at hi. At hi = l_mt the tendon has no length
+        // left and cannot pull. The residual at lo is known to be positive once a point
+        // there has been evaluated (`lo_pulls`); the first bisection checks the bottom.
+        let mut lo_pulls = r > 0.0;
+        if lo_pulls {
             lo = x;
         } else {
             hi = x;
-            if residual(lo) <= 0.0 {
-                // A unit shorter than its slack tendon with a pulling fibre: the fibre
-                // shortens as far as it can.
-                return state(lo);
-            }
         }
         // Safeguarded Newton from the previous fibre length, bisecting whenever the step
         // would leave the bracket.
-        let dx = 1e-7 * self.optimal_fibre_length;
         let tol = 1e-10 * self.optimal_fibre_length;
         for k in 0..MAX_ITERATIONS {
             // The first pass reuses the residual that set up the bracket.
             if k > 0 {
-                r = residual(x);
+                (r, slope) = residual(x);
                 if r > 0.0 {
-                    lo = x;
+                    (lo, lo_pulls) = (x, true);
                 } else {
                     hi = x;
                 }
             }
-            let slope = (residual(x + dx) - r) / dx;
             let newton = x - r / slope;
+            if newton.is_finite() && (newton - x).abs() <= tol {
+                // Converged. (Tested before the bracket: the last step may land on its
+                // end in rounding, which would send a bisection far from the root.)
+                x = newton;
+                break;
+            }
             let next = if newton.is_finite() && newton > lo && newton < hi {
                 newton
             } else {
+                if !lo_pulls {
+                    if residual(lo).0 <= 0.0 {
+                        // A unit shorter than its slack tendon with a pulling fibre: the
+                        // fibre shortens as far as it can.
+                        return state(lo);
+                    }
+                    lo_pulls = true;
+                }
                 0.5 * (lo + hi)
             };
-            let done = (next - x).abs() <= tol || hi - lo <= tol;
+            let done = hi - lo <= tol;
             x = next;
             if done {
                 break;
             }
         }
         state(x)
+    }
+
+    /// Tendon pull minus fibre pull along the tendon (N) when the fibre spans `x` (m)
+    /// along it, and its slope d/dx: the residual the step solves. De Groote's passive
+    /// curve dips below zero short of optimal length, so a fibre never pushes; the
+    /// residual never rises with x. The same curves as [`HillParams::force`], each
+    /// exponential evaluated once for value and slope.
+    fn balance(&self, a: f64, l_mt: f64, prev: f64, h: Option<f64>, x: f64) -> (f64, f64) {
+        let (fmax, lopt, lts) = (
+            self.max_isometric_force,
+            self.optimal_fibre_length,
+            self.tendon_slack_length,
+        );
+        let height = lopt * self.pennation.sin();
+        let v_scale = 1.0 / (self.max_contraction_velocity * lopt);
+        let length = (x * x + height * height).sqrt();
+        let cos = x / length;
+        let dcos = height * height / (length * length * length);
+        // Fibre length and velocity (normalised) and their slopes along x.
+        let (l, dl) = (length / lopt, cos / lopt);
+        let (v, dv) = match h {
+            Some(h) => ((length - prev) / h * v_scale, cos / h * v_scale),
+            None => (0.0, 0.0),
+        };
+        let (fpe, dfpe) = passive_force_length_and_slope(l);
+        let (act, dact) = if a > 0.0 {
+            let (fl, dfl) = active_force_length_and_slope(l);
+            let (fv, dfv) = force_velocity_and_slope(v.clamp(-1.0, 1.0));
+            let dfv = if v.abs() < 1.0 { dfv * dv } else { 0.0 };
+            (a * fl * fv, a * (dfl * dl * fv + fl * dfv))
+        } else {
+            (0.0, 0.0)
+        };
+        let frac = act + fpe + self.fibre_damping * v;
+        let dfrac = dact + dfpe * dl + self.fibre_damping * dv;
+        let (fibre, dfibre) = if frac > 0.0 {
+            (fmax * frac * cos, fmax * (dfrac * cos + frac * dcos))
+        } else {
+            (0.0, 0.0)
+        };
+        let (ft, dft) = tendon_force_length_and_slope((l_mt - x) / lts);
+        let (tendon, dtendon) = if ft > 0.0 {
+            (fmax * ft, -fmax * dft / lts)
+        } else {
+            (0.0, 0.0)
+        };
+        (tendon - fibre, dtendon - dfibre)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_balance_slope_is_the_derivative_of_the_balance() {
+        // Pennate and not, static and stepping, active and passive, shortening and
+        // lengthening (prev on either side of x), all within the force-velocity curve's
+        // unclamped range (|x − prev| < h·v_max·l_opt = 0.01 m).
+        for (pennation, a, h, prev) in [
+            (0.0, 1.0, Some(1e-2), 0.101),
+            (0.3, 0.7, Some(1e-2), 0.099),
+            (0.3, 0.0, Some(1e-2), 0.1),
+            (0.2, 0.5, None, 0.1),
+        ] {
+            let p = HillParams::new(1000.0, 0.1, 0.25, pennation, 10.0);
+            let l_mt = 0.1 + 0.25 * 1.03;
+            for k in 0..20 {
+                let x = 0.092 + 0.0008 * f64::from(k);
+                let (r, dr) = p.balance(a, l_mt, prev, h, x);
+                let d = 1e-9;
+                let fd = (p.balance(a, l_mt, prev, h, x + d).0
+                    - p.balance(a, l_mt, prev, h, x - d).0)
+                    / (2.0 * d);
+                assert!(
+                    (dr - fd).abs() <= 1e-4 * (1.0 + fd.abs()),
+                    "pennation {pennation}, a {a}, x {x}: r {r}, slope {dr} vs {fd}"
+                );
+            }
+        }
     }
 }

@@ -29,6 +29,65 @@ pub enum TendonModel {
     Compliant,
 }
 
+impl MuscleModel {
+    /// Every model, in the order fronts list them.
+    pub const ALL: [Self; 2] = [Self::Hill, Self::Spring];
+
+    /// The name used in scenarios, the CLI and Python (`"hill"`, `"spring"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Hill => "hill",
+            Self::Spring => "spring",
+        }
+    }
+}
+
+impl std::str::FromStr for MuscleModel {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<Self> {
+        parse_choice("muscle_model", s, &Self::ALL, |m| m.name())
+    }
+}
+
+impl TendonModel {
+    /// Every model, in the order fronts list them.
+    pub const ALL: [Self; 2] = [Self::Rigid, Self::Compliant];
+
+    /// The name used in scenarios, the CLI and Python (`"rigid"`, `"compliant"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Rigid => "rigid",
+            Self::Compliant => "compliant",
+        }
+    }
+}
+
+impl std::str::FromStr for TendonModel {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<Self> {
+        parse_choice("tendon", s, &Self::ALL, |m| m.name())
+    }
+}
+
+/// The choice named `s` among `all`, or an error naming the option and the choices.
+fn parse_choice<T: Copy>(
+    option: &str,
+    s: &str,
+    all: &[T],
+    name: fn(T) -> &'static str,
+) -> Result<T> {
+    all.iter().copied().find(|&c| name(c) == s).ok_or_else(|| {
+        let names: Vec<String> = all.iter().map(|&c| format!("'{}'", name(c))).collect();
+        Error::invalid(
+            option,
+            format!("'{s}'"),
+            format!("expected {}", names.join(" or ")),
+        )
+    })
+}
+
 /// Options of a [`super::Simulation`]. Every field has a documented default.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]

@@ -2,6 +2,7 @@
 //! read the knee and the muscles.
 
 mod config;
+mod models;
 mod schedule;
 mod stepping;
 mod surface;
@@ -65,6 +66,8 @@ pub struct SimulationState {
     frames: BodyFrames,
     knee_torque: f64,
     tissue: Option<Tissue>,
+    /// The models may be switched mid-run: a checkpoint replays with the ones it had.
+    models: (MuscleModel, TendonModel),
 }
 
 impl SimulationState {
@@ -220,20 +223,14 @@ impl Simulation {
             m.chain.update_wrap();
             m.path_length = m.chain.path_length();
             m.path_velocity = 0.0;
-            if self.config.tendon == TendonModel::Compliant
-                && self.config.muscle_model == MuscleModel::Hill
-            {
-                // After a jump the fibre starts in static equilibrium with its tendon at
-                // the new length (a step across the jump would read it as a huge velocity).
-                m.fibre =
-                    m.hill
-                        .compliant_tendon_step(m.activation, m.path_length, m.fibre.length, None);
-            }
             if m.crosses_knee {
                 m.moment_arm = m.chain.moment_arm(&axis, BodyId::Shank);
                 m.current_moment_arm = m.moment_arm;
             }
         }
+        // After a jump a compliant fibre starts in static equilibrium with its tendon at
+        // the new length (a step across the jump would read it as a huge velocity).
+        self.start_fibres();
     }
 
     /// The built-in phantom with the default lattice options and muscle catalogue.
@@ -515,7 +512,8 @@ impl Simulation {
         }
     }
 
-    /// A checkpoint of everything that changes while stepping.
+    /// A checkpoint of everything that changes while stepping, the muscle and tendon models
+    /// included (they may be switched mid-run).
     pub fn state(&self) -> SimulationState {
         SimulationState {
             time: self.time,
@@ -525,6 +523,7 @@ impl Simulation {
             frames: self.frames,
             knee_torque: self.knee_torque,
             tissue: self.tissue.clone(),
+            models: (self.config.muscle_model, self.config.tendon),
         }
     }
 
@@ -547,6 +546,7 @@ impl Simulation {
         self.frames = s.frames;
         self.knee_torque = s.knee_torque;
         self.tissue.clone_from(&s.tissue);
+        (self.config.muscle_model, self.config.tendon) = s.models;
         Ok(())
     }
 }

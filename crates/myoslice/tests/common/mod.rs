@@ -3,6 +3,7 @@
 #![allow(clippy::unwrap_used)] // tests fail loudly by design
 
 use std::path::PathBuf;
+use std::sync::OnceLock;
 
 use myoslice::prelude::*;
 
@@ -32,4 +33,21 @@ pub fn vh_leg() -> Option<(LabelVolume, LabelTable)> {
     let v = read_nifti(&vol).expect("the Visible Human volume loads as it is");
     let t = LabelTable::from_path(&lab).expect("the Visible Human label table loads as it is");
     Some((v, t))
+}
+
+/// The knee's hamstrings.
+pub const HAMSTRINGS: [&str; 4] = [
+    "semitendinosus",
+    "semimembranosus",
+    "biceps_femoris_long",
+    "biceps_femoris_short",
+];
+
+/// The phantom's lattice, built once per test binary.
+pub fn phantom_lattice() -> &'static Lattice {
+    static L: OnceLock<Lattice> = OnceLock::new();
+    L.get_or_init(|| {
+        let (v, t) = Phantom::default().generate().unwrap();
+        Lattice::build(&v, &t, &BuildOptions::default()).unwrap()
+    })
 }
