@@ -155,6 +155,18 @@ def test_flexors_raise_the_knee(env: Any) -> None:
     assert obs[0] > 0.5
 
 
+def test_compliant_tendons_reach_the_policy_through_the_simulation() -> None:
+    env = KneeReach(tendon="compliant", muscles=["semitendinosus", "biceps_femoris_long"])
+    try:
+        assert env.simulation.tendon == "compliant"
+        obs, _ = env.reset(seed=0)
+        for _ in range(25):  # 0.5 s of both flexors at full excitation
+            obs, *_ = env.step(np.ones(2, dtype=np.float32))
+        assert obs[0] > 0.3 and obs in env.observation_space
+    finally:
+        env.close()
+
+
 def test_episode_is_truncated_on_time() -> None:
     env = gymnasium.make(ENV_ID, episode_seconds=0.1, control_dt=0.02)
     try:
@@ -196,6 +208,7 @@ def test_custom_muscles_and_bad_options() -> None:
         {"effort_weight": math.nan},
         {"target_range_deg": (90.0, 10.0)},
         {"muscles": []},
+        {"tendon": "elastic"},
     ]
     for kwargs in bad:
         with pytest.raises(InvalidInputError):

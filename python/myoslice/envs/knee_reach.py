@@ -74,6 +74,7 @@ class KneeReach(gymnasium.Env[Obs, Action]):
         control_dt: float = 0.02,
         effort_weight: float = 0.01,
         tissue: bool = False,
+        tendon: str = "rigid",
         muscles: Sequence[str] | None = None,
         render_size: tuple[int, int] = (480, 360),
         camera: str = "side",
@@ -87,6 +88,8 @@ class KneeReach(gymnasium.Env[Obs, Action]):
             effort_weight: weight of the mean squared excitation in the reward.
             tissue: also simulate the deformable tissue (slower; only matters for
                 rendering and the tissue metrics of :attr:`simulation`).
+            tendon: ``"rigid"`` or ``"compliant"`` (elastic tendons: the fibre lengths
+                become states the policy cannot see directly).
             muscles: names of the controlled muscles; default: the knee flexors and
                 extensors.
             render_size: ``(width, height)`` of rendered frames (pixels).
@@ -119,7 +122,7 @@ class KneeReach(gymnasium.Env[Obs, Action]):
         if muscles is not None and len(muscles) == 0:
             raise InvalidInputError("muscles = []: expected at least one muscle (or None for the default)")
 
-        self._sim: Simulation | None = Simulation.phantom(tissue=tissue)
+        self._sim: Simulation | None = Simulation.phantom(tissue=tissue, tendon=tendon)
         sim = self._sim
         names = sim.muscle_names
         if muscles is None:
