@@ -260,3 +260,19 @@ fn model_names_parse_back_and_unknown_ones_are_named_in_the_error() {
     let e = "elastic".parse::<TendonModel>().unwrap_err().to_string();
     assert!(e.contains("tendon") && e.contains("'compliant'"), "{e}");
 }
+
+#[test]
+fn an_active_fibre_on_a_slack_tendon_shortens_at_its_maximum_speed() {
+    // The unit is shorter than its tendon's slack length: nothing resists the fibre, so
+    // backward Euler lets it shorten at about v_max per step, where its force vanishes
+    // (not to the bottom of the bracket in one step).
+    let p = unit();
+    let (lopt, h) = (p.optimal_fibre_length, 1e-3);
+    let f = p.compliant_tendon_step(1.0, 0.8 * p.tendon_slack_length, lopt, Some(h));
+    let shortening = (lopt - f.length) / (p.max_contraction_velocity * lopt * h);
+    assert!(
+        (0.95..=1.0).contains(&shortening),
+        "shortened by {shortening} of v_max·h"
+    );
+    assert!(p.force(1.0, &f).tendon <= 1e-6 * p.max_isometric_force);
+}

@@ -78,6 +78,9 @@ impl HillParams {
             // The first pass reuses the residual that set up the bracket.
             if k > 0 {
                 (r, slope) = residual(x);
+                if r == 0.0 {
+                    break; // an exact root (or a slack unit: nothing pulls)
+                }
                 if r > 0.0 {
                     (lo, lo_pulls) = (x, true);
                 } else {
