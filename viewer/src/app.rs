@@ -268,7 +268,7 @@ impl App {
         for a in actions {
             let r: Result<()> = match a {
                 UiAction::Reset => load(&self.ui.source, self.scenario.as_ref()).map(|s| {
-                    self.sim = s;
+                    self.sim = with_models_of(s, &self.sim);
                     self.ui.default_plot(&self.sim);
                 }),
                 UiAction::Step => self
@@ -283,7 +283,7 @@ impl App {
                 }
                 UiAction::Load(src) => match load(&src, None) {
                     Ok(s) => {
-                        self.sim = s;
+                        self.sim = with_models_of(s, &self.sim);
                         self.ui.selected = None;
                         self.ui.hovered = None;
                         self.ui.source = src;
@@ -537,5 +537,30 @@ impl ApplicationHandler for App {
         if let Some(g) = &self.gfx {
             g.window.request_redraw();
         }
+    }
+}
+
+/// `new` with the muscle and tendon models `old` runs now: the panel's choice outlives a
+/// reset or a load (the source's own models are only where a session starts).
+fn with_models_of(mut new: Simulation, old: &Simulation) -> Simulation {
+    new.set_muscle_model(old.muscle_model());
+    new.set_tendon_model(old.tendon_model());
+    new
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_reset_or_a_load_keeps_the_models_chosen_in_the_panel() {
+        let mut config = SimulationConfig::default();
+        config.tissue.enabled = false;
+        let mut old = Simulation::phantom(config.clone()).expect("phantom");
+        old.set_muscle_model(MuscleModel::Spring);
+        old.set_tendon_model(TendonModel::Compliant);
+        let new = with_models_of(Simulation::phantom(config).expect("phantom"), &old);
+        assert_eq!(new.muscle_model(), MuscleModel::Spring);
+        assert_eq!(new.tendon_model(), TendonModel::Compliant);
     }
 }
