@@ -41,27 +41,15 @@ impl HillParams {
         prev: f64,
         h: Option<f64>,
     ) -> FibreState {
-        let height = self.optimal_fibre_length * self.pennation.sin();
-        // Unknown: the fibre's length along the tendon, x; fibre length sqrt(x² + height²).
-        let state = |x: f64| {
-            let length = (x * x + height * height).sqrt();
-            FibreState {
-                length,
-                cos_pennation: x / length,
-                velocity: h.map_or(0.0, |h| (length - prev) / h),
-            }
-        };
-        let residual = |x: f64| self.balance(a, l_mt, prev, h, x);
+        let solve = Balance::new(self, a, l_mt, prev, h);
         let (mut lo, mut hi) = (1e-4 * self.optimal_fibre_length, l_mt);
         if l_mt.is_nan() || hi <= lo {
-            return state(lo);
+            return solve.state(lo);
         }
+        let height = solve.height;
         let prev_x = (prev * prev - height * height).max(0.0).sqrt();
         let mut x = prev_x.clamp(lo, hi);
-        let (mut r, mut slope) = residual(x);
-        if r == 0.0 {
-            return state(x); // slack: nothing pulls
-        }
+        let (mut r, mut slope) = solve.residual(x);
         // Bracket [lo, hi] with residual ≤ 0 at hi. At hi = l_mt the tendon has no length
         // left and cannot pull. The residual at lo is known to be positive once a point
         // there has been evaluated (`lo_pulls`); the first bisection checks the bottom.
@@ -77,15 +65,15 @@ impl HillParams {
         for k in 0..MAX_ITERATIONS {
             // The first pass reuses the residual that set up the bracket.
             if k > 0 {
-                (r, slope) = residual(x);
-                if r == 0.0 {
-                    break; // an exact root (or a slack unit: nothing pulls)
-                }
+                (r, slope) = solve.residual(x);
                 if r > 0.0 {
                     (lo, lo_pulls) = (x, true);
                 } else {
                     hi = x;
                 }
+            }
+            if r == 0.0 {
+                break; // an exact root (or a slack unit: nothing pulls)
             }
             let newton = x - r / slope;
             if newton.is_finite() && (newton - x).abs() <= tol {
@@ -98,10 +86,10 @@ impl HillParams {
                 newton
             } else {
                 if !lo_pulls {
-                    if residual(lo).0 <= 0.0 {
+                    if solve.residual(lo).0 <= 0.0 {
                         // A unit shorter than its slack tendon with a pulling fibre: the
                         // fibre shortens as far as it can.
-                        return state(lo);
+                        return solve.state(lo);
                     }
                     lo_pulls = true;
                 }
@@ -113,22 +101,65 @@ impl HillParams {
                 break;
             }
         }
-        state(x)
+        solve.state(x)
+    }
+}
+
+/// The fixed inputs of one solve, over its unknown: the fibre's length `x` (m) along the
+/// tendon (fibre length sqrt(x² + height²), constant-thickness pennation).
+struct Balance<'a> {
+    p: &'a HillParams,
+    a: f64,
+    l_mt: f64,
+    prev: f64,
+    h: Option<f64>,
+    /// The fibre's constant thickness across the tendon (m).
+    height: f64,
+}
+
+impl<'a> Balance<'a> {
+    fn new(p: &'a HillParams, a: f64, l_mt: f64, prev: f64, h: Option<f64>) -> Self {
+        let height = p.optimal_fibre_length * p.pennation.sin();
+        Self {
+            p,
+            a,
+            l_mt,
+            prev,
+            h,
+            height,
+        }
     }
 
-    /// Tendon pull minus fibre pull along the tendon (N) when the fibre spans `x` (m)
-    /// along it, and its slope d/dx: the residual the step solves. De Groote's passive
-    /// curve dips below zero short of optimal length, so a fibre never pushes; the
-    /// residual never rises with x. The same curves as [`HillParams::force`], each
-    /// exponential evaluated once for value and slope.
-    fn balance(&self, a: f64, l_mt: f64, prev: f64, h: Option<f64>, x: f64) -> (f64, f64) {
+    /// The fibre state at `x`.
+    fn state(&self, x: f64) -> FibreState {
+        let length = (x * x + self.height * self.height).sqrt();
+        FibreState {
+            length,
+            cos_pennation: x / length,
+            velocity: self.h.map_or(0.0, |h| (length - self.prev) / h),
+        }
+    }
+
+    /// Tendon pull minus fibre pull along the tendon (N) at `x`, and its slope d/dx: the
+    /// residual the step solves. De Groote's passive curve dips below zero short of
+    /// optimal length, so a fibre never pushes; the residual never rises with x. The same
+    /// curves as [`HillParams::force`], each exponential evaluated once for value and
+    /// slope.
+    fn residual(&self, x: f64) -> (f64, f64) {
+        let Self {
+            p,
+            a,
+            l_mt,
+            prev,
+            h,
+            height,
+        } = *self;
         let (fmax, lopt, lts) = (
-            self.max_isometric_force,
-            self.optimal_fibre_length,
-            self.tendon_slack_length,
+            p.max_isometric_force,
+            p.optimal_fibre_length,
+            p.tendon_slack_length,
         );
-        let height = lopt * self.pennation.sin();
-        let v_scale = 1.0 / (self.max_contraction_velocity * lopt);
+        let v_scale = 1.0 / (p.max_contraction_velocity * lopt);
         let length = (x * x + height * height).sqrt();
         let cos = x / length;
         let dcos = height * height / (length * length * length);
@@ -147,8 +178,8 @@ impl HillParams {
         } else {
             (0.0, 0.0)
         };
-        let frac = act + fpe + self.fibre_damping * v;
-        let dfrac = dact + dfpe * dl + self.fibre_damping * dv;
+        let frac = act + fpe + p.fibre_damping * v;
+        let dfrac = dact + dfpe * dl + p.fibre_damping * dv;
         let (fibre, dfibre) = if frac > 0.0 {
             (fmax * frac * cos, fmax * (dfrac * cos + frac * dcos))
         } else {
@@ -183,11 +214,10 @@ mod tests {
             let l_mt = 0.1 + 0.25 * 1.03;
             for k in 0..20 {
                 let x = 0.092 + 0.0008 * f64::from(k);
-                let (r, dr) = p.balance(a, l_mt, prev, h, x);
+                let solve = Balance::new(&p, a, l_mt, prev, h);
+                let (r, dr) = solve.residual(x);
                 let d = 1e-9;
-                let fd = (p.balance(a, l_mt, prev, h, x + d).0
-                    - p.balance(a, l_mt, prev, h, x - d).0)
-                    / (2.0 * d);
+                let fd = (solve.residual(x + d).0 - solve.residual(x - d).0) / (2.0 * d);
                 assert!(
                     (dr - fd).abs() <= 1e-4 * (1.0 + fd.abs()),
                     "pennation {pennation}, a {a}, x {x}: r {r}, slope {dr} vs {fd}"
