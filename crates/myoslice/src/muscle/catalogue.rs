@@ -187,13 +187,21 @@ impl MuscleCatalogue {
                 ("origin_site", &e.origin_site),
                 ("insertion_site", &e.insertion_site),
             ] {
+                // The pes anserinus is an insertion site only.
+                let anteromedial = key == "insertion_site" && v.as_deref() == Some("anteromedial");
                 if let Some(v) = v
+                    && !anteromedial
                     && !matches!(v.as_str(), "nearest" | "superior" | "inferior")
                 {
+                    let also = if key == "insertion_site" {
+                        ", anteromedial"
+                    } else {
+                        ""
+                    };
                     return Err(Error::Parse {
                         path: origin.into(),
                         reason: format!(
-                            "muscle.{name}.{key} = '{v}': expected nearest, superior or inferior"
+                            "muscle.{name}.{key} = '{v}': expected nearest, superior, inferior{also}"
                         ),
                     });
                 }
@@ -276,5 +284,20 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("force"), "{e}");
+    }
+
+    #[test]
+    fn the_pes_anserinus_is_an_insertion_site_only() {
+        let head = "[default]\nspecific_tension_pa = 1\nfibre_fraction = 0.5\npennation_deg = 0\nmax_contraction_velocity = 10\nrest_fibre_length = 1\n[muscle.x]\n";
+        let ok = format!("{head}insertion_site = \"anteromedial\"\n");
+        assert!(MuscleCatalogue::from_toml_str(&ok, "c.toml").is_ok());
+        let bad = format!("{head}origin_site = \"anteromedial\"\n");
+        let e = MuscleCatalogue::from_toml_str(&bad, "c.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("muscle.x.origin_site = 'anteromedial'") && !e.contains(", anteromedial"),
+            "{e}"
+        );
     }
 }

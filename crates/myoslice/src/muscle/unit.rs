@@ -227,9 +227,14 @@ impl MuscleUnit {
             Some(d) => beyond(ob, o_end, d as f32),
             None => site(ob, o_end, entry.and_then(|e| e.origin_site.as_ref())),
         };
+        let i_site = entry.and_then(|e| e.insertion_site.as_ref());
         let i_att = match entry.and_then(|e| e.insertion_below_knee_m) {
+            _ if i_site.is_some_and(|s| s == "anteromedial") => {
+                let below = entry.and_then(|e| e.insertion_below_knee_m).unwrap_or(0.0);
+                anteromedial(lattice, ib, knee, below as f32).unwrap_or_else(|| project(ib, i_end))
+            }
             Some(d) => beyond(ib, i_end, -d as f32),
-            None => site(ib, i_end, entry.and_then(|e| e.insertion_site.as_ref())),
+            None => site(ib, i_end, i_site),
         };
         let belly_len: f64 = belly
             .windows(2)
@@ -378,7 +383,18 @@ impl MuscleUnit {
                 .unwrap_or(n - 2);
             chain.wrap_segment = k;
             let (p, q) = (chain.x[k], chain.x[k + 1]);
-            let side = WrapCylinder::side_of(knee.point, knee.axis, p, q);
+            // A flexor's tendon never crosses the front of the knee nor an extensor's its
+            // back, even where the straight line at rest would (the pes anserinus lies in
+            // front of the axis; its tendons come round the medial condyle from behind).
+            let side = match entry.and_then(|e| e.group) {
+                Some(MuscleGroup::Flexor) => {
+                    WrapCylinder::side_avoiding(knee.point, knee.axis, p, q, Vec3::Y)
+                }
+                Some(MuscleGroup::Extensor) => {
+                    WrapCylinder::side_avoiding(knee.point, knee.axis, p, q, Vec3::NEG_Y)
+                }
+                _ => WrapCylinder::side_of(knee.point, knee.axis, p, q),
+            };
             let probe = WrapCylinder {
                 point: knee.point,
                 axis: knee.axis,
@@ -397,6 +413,9 @@ impl MuscleUnit {
                 .map_or((0.9 * clearance).clamp(0.01, 0.06), |r| r as f32)
                 .min(room);
             chain.wrap = Some(WrapCylinder { radius, ..probe });
+            // A straight line on the wrong side at rest starts wrapped (a wrapped path
+            // stays so until it clears the cylinder on its side).
+            chain.wrapped = probe.clearance(p, q) < 0.0;
             chain.update_wrap();
         }
         chain.attach_ends(&BodyFrames::REST);
@@ -466,6 +485,26 @@ fn wrap_fits(chain: &MuscleChain, knee: &KneeAxis) -> bool {
         .unwrap_or(n - 2);
     let d = chain.x[k] - knee.point;
     (d - knee.axis * d.dot(knee.axis)).length() >= 2.5 * WRAP_MIN_RADIUS
+}
+
+/// The most anteromedial vertex of bone `bone` in a band just below `below` m under the
+/// knee axis: the pes anserinus, where the semitendinosus, gracilis and sartorius insert
+/// on the tibia's anteromedial face after wrapping round its medial condyle. Medial is
+/// the side away from the fibula; without a fibula, anterior alone.
+fn anteromedial(lattice: &Lattice, bone: usize, knee: &KneeAxis, below: f32) -> Option<Vec3> {
+    const BAND: f32 = 0.015;
+    let medial = bone_index(lattice, "fibula").map_or(Vec3::ZERO, |f| {
+        Vec3::X * (bone_centroid(lattice, bone).x - bone_centroid(lattice, f).x).signum()
+    });
+    let dir = (Vec3::Y + medial).normalize();
+    let top = knee.point.z - below;
+    lattice.bones[bone]
+        .mesh
+        .vertices
+        .iter()
+        .copied()
+        .filter(|v| v.z <= top && v.z >= top - BAND)
+        .max_by(|a, b| a.dot(dir).total_cmp(&b.dot(dir)))
 }
 
 /// Smallest wrap cylinder considered (m).

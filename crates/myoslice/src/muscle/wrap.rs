@@ -67,6 +67,27 @@ impl WrapCylinder {
         if a.perp_dot(b) >= 0.0 { 1.0 } else { -1.0 }
     }
 
+    /// The side (+1/−1) a path from `p` to `q` round the axis takes so as not to pass
+    /// over the direction `avoid` (a flexor's tendon never crosses the front of the knee
+    /// nor an extensor's its back, whichever way the straight line would go).
+    pub fn side_avoiding(point: Vec3, axis: Vec3, p: Vec3, q: Vec3, avoid: Vec3) -> f32 {
+        let c = WrapCylinder {
+            point,
+            axis,
+            radius: 0.0,
+            side: 1.0,
+        };
+        let (a, _) = c.planar(p);
+        let (b, _) = c.planar(q);
+        let (t, _) = c.planar(point + avoid);
+        let ccw = |u: DVec2, v: DVec2| {
+            u.perp_dot(v)
+                .atan2(u.dot(v))
+                .rem_euclid(std::f64::consts::TAU)
+        };
+        if ccw(a, t) < ccw(a, b) { -1.0 } else { 1.0 }
+    }
+
     /// Signed distance (m) of the straight line p→q from the axis, positive on `side`.
     pub fn clearance(&self, p: Vec3, q: Vec3) -> f32 {
         let (a, _) = self.planar(p);
@@ -141,6 +162,28 @@ impl WrapCylinder {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_flexor_passes_behind_the_axis_even_where_the_straight_line_is_in_front() {
+        // Axis along x; p above and slightly behind, q below and in front (+y anterior).
+        let (o, x) = (Vec3::ZERO, Vec3::X);
+        let p = Vec3::new(0.0, -0.01, 0.10);
+        let q = Vec3::new(0.0, 0.02, -0.04);
+        let front = WrapCylinder::side_of(o, x, p, q);
+        let behind = WrapCylinder::side_avoiding(o, x, p, q, Vec3::Y);
+        assert_eq!(behind, -front);
+        assert_eq!(WrapCylinder::side_avoiding(o, x, p, q, Vec3::NEG_Y), front);
+        let c = WrapCylinder {
+            point: o,
+            axis: x,
+            radius: 0.03,
+            side: behind,
+        };
+        let w = c.path(p, q, false);
+        assert!(w.wrapped);
+        // The path leaves p going backward (−y) and reaches q from behind.
+        assert!(w.dir_p.y < 0.0 && w.dir_q.y < 0.0, "{w:?}");
+    }
 
     #[test]
     fn a_path_clear_of_the_cylinder_is_straight_and_a_blocked_one_wraps() {

@@ -31,7 +31,7 @@ use crate::error::{Result, check_range};
 use crate::lattice::{InnerContact, Lattice};
 use crate::muscle::{BodyFrames, MuscleUnit};
 pub use bone_keep_out::BoneOverlap;
-use bone_keep_out::Bones;
+use bone_keep_out::{Bones, KeepOutMemory};
 use bone_slide::{BoneMesh, BoneSlide};
 use guard::Guard;
 
@@ -186,7 +186,7 @@ pub(crate) struct TissueBackup {
     theta: f32,
     metrics: TissueMetrics,
     bone_slide: BoneSlide,
-    muscles: Vec<(Vec<Vec3>, f64, Vec<Vec3>)>,
+    muscles: Vec<(Vec<Vec3>, f64, KeepOutMemory)>,
 }
 
 impl Tissue {
@@ -343,9 +343,9 @@ impl Tissue {
                 .all(|m| m.current.iter().all(|p| p.is_finite()))
     }
 
-    /// Everything an update changes and the next one reads. Not the clock: `step`
-    /// advances it and puts it back itself. Not the pairs watched against bone: they only
-    /// skip checks a ball known clear of the bone vouches for, whatever its age.
+    /// Everything an update changes and the next one reads, the pairs watched against
+    /// bone included (where each walk starts). Not the clock: `step` advances it and puts
+    /// it back itself.
     pub(crate) fn backup(&self) -> TissueBackup {
         TissueBackup {
             fat_x: self.fat.x.clone(),
@@ -359,7 +359,7 @@ impl Tissue {
             muscles: self
                 .muscles
                 .iter()
-                .map(|m| (m.current.clone(), m.volume_now, m.keep.shift.clone()))
+                .map(|m| (m.current.clone(), m.volume_now, m.keep.memory()))
                 .collect(),
         }
     }
@@ -370,8 +370,9 @@ impl Tissue {
         (self.fat.free, self.fat.active) = (b.fat_free, b.fat_active);
         (self.drift, self.theta, self.metrics) = (b.drift, b.theta, b.metrics);
         self.bone_slide = b.bone_slide;
-        for (shape, (c, v, shift)) in self.muscles.iter_mut().zip(b.muscles) {
-            (shape.current, shape.volume_now, shape.keep.shift) = (c, v, shift);
+        for (shape, (c, v, keep)) in self.muscles.iter_mut().zip(b.muscles) {
+            (shape.current, shape.volume_now) = (c, v);
+            shape.keep.recall(keep);
         }
     }
 

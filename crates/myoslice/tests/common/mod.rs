@@ -43,6 +43,29 @@ pub const HAMSTRINGS: [&str; 4] = [
     "biceps_femoris_short",
 ];
 
+/// The knee's quadriceps.
+pub const QUADRICEPS: [&str; 4] = [
+    "rectus_femoris",
+    "vastus_lateralis",
+    "vastus_medialis",
+    "vastus_intermedius",
+];
+
+/// Force-weighted moment arm (m) of a muscle group at `deg` of flexion: the group's
+/// effective lever.
+pub fn group_moment_arm(base: &Simulation, names: &[&str], deg: f64) -> f64 {
+    let mut s = base.clone();
+    s.set_knee(deg.to_radians(), 0.0).unwrap();
+    let (mut num, mut den) = (0.0, 0.0);
+    for m in names {
+        let i = s.muscle_index(m).unwrap();
+        let f = s.muscles()[i].hill.max_isometric_force;
+        num += f * s.muscle(m).unwrap().moment_arm;
+        den += f;
+    }
+    num / den
+}
+
 /// The phantom's lattice, built once per test binary.
 pub fn phantom_lattice() -> &'static Lattice {
     static L: OnceLock<Lattice> = OnceLock::new();
