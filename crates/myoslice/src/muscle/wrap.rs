@@ -54,16 +54,20 @@ impl WrapCylinder {
         self.point + e1 * q.x as f32 + e2 * q.y as f32 + self.axis * h
     }
 
-    /// The side (+1/−1) a path from `p` to `q` passes the axis on.
-    pub fn side_of(point: Vec3, axis: Vec3, p: Vec3, q: Vec3) -> f32 {
+    /// Where `ps` lie in the plane across the axis through `point` along `axis`.
+    fn across<const N: usize>(point: Vec3, axis: Vec3, ps: [Vec3; N]) -> [DVec2; N] {
         let c = WrapCylinder {
             point,
             axis,
             radius: 0.0,
             side: 1.0,
         };
-        let (a, _) = c.planar(p);
-        let (b, _) = c.planar(q);
+        ps.map(|p| c.planar(p).0)
+    }
+
+    /// The side (+1/−1) a path from `p` to `q` passes the axis on.
+    pub fn side_of(point: Vec3, axis: Vec3, p: Vec3, q: Vec3) -> f32 {
+        let [a, b] = Self::across(point, axis, [p, q]);
         if a.perp_dot(b) >= 0.0 { 1.0 } else { -1.0 }
     }
 
@@ -71,15 +75,7 @@ impl WrapCylinder {
     /// over the direction `avoid` (a flexor's tendon never crosses the front of the knee
     /// nor an extensor's its back, whichever way the straight line would go).
     pub fn side_avoiding(point: Vec3, axis: Vec3, p: Vec3, q: Vec3, avoid: Vec3) -> f32 {
-        let c = WrapCylinder {
-            point,
-            axis,
-            radius: 0.0,
-            side: 1.0,
-        };
-        let (a, _) = c.planar(p);
-        let (b, _) = c.planar(q);
-        let (t, _) = c.planar(point + avoid);
+        let [a, b, t] = Self::across(point, axis, [p, q, point + avoid]);
         let ccw = |u: DVec2, v: DVec2| {
             u.perp_dot(v)
                 .atan2(u.dot(v))
