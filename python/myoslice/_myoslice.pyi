@@ -127,6 +127,16 @@ class Simulation:
         """Control group of each muscle: ``"flexor"``, ``"extensor"`` or ``"other"``."""
 
     @property
+    def muscle_tendons(self) -> list[str]:
+        """Tendon model of each muscle, ``"rigid"`` or ``"compliant"`` (``muscle_names``
+        order): the catalogue's ``tendon`` for that muscle, else the default."""
+
+    def set_muscle_tendon(self, name: str, tendon: str) -> None:
+        """Gives one muscle its own tendon model mid-run (``"rigid"`` or
+        ``"compliant"``); the others keep theirs and their fibre states. Raises
+        ``UnknownNameError`` or ``InvalidInputError`` and changes nothing on bad input."""
+
+    @property
     def muscle_model(self) -> str:
         """The muscle model, ``"hill"`` or ``"spring"``. Settable mid-run: the pose,
         chains and activations carry over."""
@@ -136,7 +146,8 @@ class Simulation:
     @property
     def tendon(self) -> str:
         """The Hill units' tendons, ``"rigid"`` or ``"compliant"``. Settable mid-run:
-        a compliant fibre starts in static equilibrium with its tendon."""
+        a compliant fibre starts in static equilibrium with its tendon. Setting it gives
+        every muscle that tendon; reading it gives the default (see ``muscle_tendons``)."""
 
     @tendon.setter
     def tendon(self, value: str) -> None: ...

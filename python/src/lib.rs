@@ -343,6 +343,19 @@ impl PySimulation {
             .collect()
     }
 
+    /// Tendon model of each muscle, "rigid" or "compliant" (in `muscle_names` order).
+    #[getter]
+    fn muscle_tendons(&self) -> Vec<&'static str> {
+        self.sim.muscles().iter().map(|m| m.tendon.name()).collect()
+    }
+
+    /// Gives one muscle its own tendon model mid-run, "rigid" or "compliant"; the others
+    /// keep theirs (and their fibre states).
+    fn set_muscle_tendon(&mut self, py: Python<'_>, name: &str, tendon: &str) -> PyResult<()> {
+        let tendon = tendon.parse().or_py(py)?;
+        self.sim.set_muscle_tendon(name, tendon).or_py(py)
+    }
+
     /// The muscle model, "hill" or "spring"; settable mid-run.
     #[getter]
     fn muscle_model(&self) -> &'static str {
@@ -356,7 +369,8 @@ impl PySimulation {
     }
 
     /// The Hill units' tendons, "rigid" or "compliant"; settable mid-run (a compliant
-    /// fibre starts in static equilibrium with its tendon).
+    /// fibre starts in static equilibrium with its tendon). Setting it gives every muscle
+    /// that tendon; reading it gives the default (see `muscle_tendons`).
     #[getter]
     fn tendon(&self) -> &'static str {
         self.sim.tendon_model().name()

@@ -304,6 +304,29 @@ def test_models_switch_on_a_running_simulation(rigid: Simulation) -> None:
     assert (rigid.muscle_model, rigid.tendon) == ("spring", "compliant")
 
 
+def test_one_muscle_takes_its_own_tendon(rigid: Simulation) -> None:
+    flex(rigid, 0.1)
+    names = rigid.muscle_names
+    st = names.index("semitendinosus")
+    fibres = rigid.fibre_lengths
+    rigid.set_muscle_tendon("semitendinosus", "compliant")
+    tendons = rigid.muscle_tendons
+    assert tendons[st] == "compliant"
+    assert all(t == "rigid" for i, t in enumerate(tendons) if i != st)
+    assert rigid.tendon == "rigid"  # the default stays
+    # Only its fibre moved: the others keep their state.
+    changed = np.flatnonzero(rigid.fibre_lengths != fibres)
+    assert changed.tolist() == [st]
+    with pytest.raises(myoslice.UnknownNameError, match="semitendinosus"):
+        rigid.set_muscle_tendon("semitendinosis", "rigid")
+    with pytest.raises(InvalidInputError, match="tendon"):
+        rigid.set_muscle_tendon("semitendinosus", "elastic")
+    assert rigid.muscle_tendons == tendons
+    # The global switch gives every muscle the same tendon again.
+    rigid.tendon = "rigid"
+    assert set(rigid.muscle_tendons) == {"rigid"}
+
+
 def test_set_knee(rigid: Simulation) -> None:
     rigid.set_knee(0.8)
     assert rigid.knee_angle == pytest.approx(0.8, abs=1e-6)

@@ -544,7 +544,11 @@ impl ApplicationHandler for App {
 /// reset or a load (the source's own models are only where a session starts).
 fn with_models_of(mut new: Simulation, old: &Simulation) -> Simulation {
     new.set_muscle_model(old.muscle_model());
-    new.set_tendon_model(old.tendon_model());
+    // Only a changed default: the global switch would override tendons the catalogue
+    // gives single muscles.
+    if new.tendon_model() != old.tendon_model() {
+        new.set_tendon_model(old.tendon_model());
+    }
     new
 }
 

@@ -32,7 +32,10 @@ pub fn show(ui: &mut egui::Ui, sim: &mut Simulation) {
                 TendonModel::name,
             );
         });
-        sim.set_tendon_model(tendon);
+        // Only when chosen: every muscle takes it, those with a tendon of their own too.
+        if tendon != sim.tendon_model() {
+            sim.set_tendon_model(tendon);
+        }
         ui.end_row();
     });
 }

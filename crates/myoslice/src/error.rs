@@ -186,6 +186,23 @@ fn edit_distance(a: &str, b: &str) -> usize {
     prev[b.len()]
 }
 
+/// The choice named `s` among `all`, or an error naming the option and the choices.
+pub(crate) fn parse_choice<T: Copy>(
+    option: &str,
+    s: &str,
+    all: &[T],
+    name: fn(T) -> &'static str,
+) -> Result<T> {
+    all.iter().copied().find(|&c| name(c) == s).ok_or_else(|| {
+        let names: Vec<String> = all.iter().map(|&c| format!("'{}'", name(c))).collect();
+        Error::invalid(
+            option,
+            format!("'{s}'"),
+            format!("expected {}", names.join(" or ")),
+        )
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -276,3 +276,107 @@ fn an_active_fibre_on_a_slack_tendon_shortens_at_its_maximum_speed() {
     );
     assert!(p.force(1.0, &f).tendon <= 1e-6 * p.max_isometric_force);
 }
+
+/// Whether muscle `i`'s fibre is where a rigid tendon puts it (bit for bit).
+fn fibre_is_rigid(s: &Simulation, i: usize) -> bool {
+    let u = &s.muscles()[i];
+    u.fibre.length
+        == u.hill
+            .rigid_tendon_kinematics(u.path_length, u.path_velocity)
+            .length
+}
+
+/// How far (m) muscle `i`'s tendon is stretched past its slack length.
+fn tendon_stretch(s: &Simulation, i: usize) -> f64 {
+    let u = &s.muscles()[i];
+    u.path_length - u.fibre.length * u.fibre.cos_pennation - u.hill.tendon_slack_length
+}
+
+#[test]
+fn one_muscle_can_have_its_own_tendon_while_the_others_keep_theirs() {
+    let mut s = sim(TendonModel::Rigid);
+    for m in HAMSTRINGS {
+        s.set_excitation(m, 0.8).unwrap();
+    }
+    s.step(0.1).unwrap();
+    let before = s.clone();
+    s.set_muscle_tendon("semitendinosus", TendonModel::Compliant)
+        .unwrap();
+    // The default is unchanged, and so is every other muscle (bit for bit).
+    assert_eq!(s.tendon_model(), TendonModel::Rigid);
+    let st = s.muscle_index("semitendinosus").unwrap();
+    for (i, (a, b)) in s.muscles().iter().zip(before.muscles()).enumerate() {
+        let expect = if i == st {
+            TendonModel::Compliant
+        } else {
+            TendonModel::Rigid
+        };
+        assert_eq!(s.readout(i).tendon, expect, "{}", a.name);
+        if i != st {
+            assert_eq!(a.fibre, b.fibre, "{}", a.name);
+        }
+    }
+    s.step(0.2).unwrap();
+    // Only the semitendinosus's loaded tendon stretches; every other fibre takes the
+    // whole path (but for the last step's path change: the fibre went with the path at
+    // the step's start).
+    for i in 0..s.muscles().len() {
+        let (stretch, name) = (tendon_stretch(&s, i), &s.muscles()[i].name);
+        if i == st {
+            assert!(stretch > 2e-3, "{name}: tendon stretched {stretch} m");
+        } else {
+            assert!(stretch.abs() < 1e-3, "{name}: tendon stretched {stretch} m");
+        }
+    }
+    // Bad input changes nothing.
+    let e = s
+        .set_muscle_tendon("semitendinosis", TendonModel::Rigid)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("did you mean 'semitendinosus'"), "{e}");
+    assert_eq!(s.muscles()[st].tendon, TendonModel::Compliant);
+    // A checkpoint carries each muscle's tendon; the global switch overrides them all.
+    let checkpoint = s.state();
+    s.set_tendon_model(TendonModel::Rigid);
+    assert!(s.muscles().iter().all(|m| m.tendon == TendonModel::Rigid));
+    assert!(fibre_is_rigid(&s, st));
+    s.set_state(&checkpoint).unwrap();
+    assert_eq!(s.muscles()[st].tendon, TendonModel::Compliant);
+    assert_eq!(s.tendon_model(), TendonModel::Rigid);
+}
+
+#[test]
+fn the_catalogue_gives_a_muscle_its_own_tendon() {
+    let mut cat = MuscleCatalogue::default();
+    let gm = cat.muscles.get_mut("gastrocnemius_medial").unwrap();
+    gm.tendon = Some(TendonModel::Compliant);
+    let mut c = SimulationConfig::default();
+    c.tissue.enabled = false;
+    let s = Simulation::new(phantom_lattice().clone(), c.clone(), &cat).unwrap();
+    for (i, m) in s.muscles().iter().enumerate() {
+        let own = m.name == "gastrocnemius_medial";
+        assert_eq!(m.tendon == TendonModel::Compliant, own, "{}", m.name);
+        assert_eq!(s.readout(i).tendon, m.tendon);
+    }
+    // A compliant default does not override a catalogued rigid tendon.
+    cat.muscles.get_mut("semitendinosus").unwrap().tendon = Some(TendonModel::Rigid);
+    c.tendon = TendonModel::Compliant;
+    let s = Simulation::new(phantom_lattice().clone(), c, &cat).unwrap();
+    assert_eq!(
+        s.muscle("semitendinosus").unwrap().tendon,
+        TendonModel::Rigid
+    );
+    assert_eq!(
+        s.muscle("semimembranosus").unwrap().tendon,
+        TendonModel::Compliant
+    );
+    // In the catalogue's text, with a bad value named.
+    let head = "[default]\nspecific_tension_pa = 1\nfibre_fraction = 0.5\npennation_deg = 0\nmax_contraction_velocity = 10\nrest_fibre_length = 1\n[muscle.x]\n";
+    let ok = MuscleCatalogue::from_toml_str(&format!("{head}tendon = \"compliant\"\n"), "c.toml")
+        .unwrap();
+    assert_eq!(ok.muscles["x"].tendon, Some(TendonModel::Compliant));
+    let e = MuscleCatalogue::from_toml_str(&format!("{head}tendon = \"elastic\"\n"), "c.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("elastic") && e.contains("c.toml"), "{e}");
+}

@@ -5,6 +5,7 @@ use std::path::Path;
 
 use serde::Deserialize;
 
+use super::TendonModel;
 use crate::error::{Error, Result};
 
 /// The embedded catalogue.
@@ -68,6 +69,10 @@ pub struct CatalogueEntry {
     pub origin_above_knee_m: Option<f64>,
     /// Normalised fibre length at the rest pose (default from `[default]`).
     pub rest_fibre_length: Option<f64>,
+    /// This muscle's tendon model (`"rigid"` or `"compliant"`), whatever the simulation's
+    /// default (`SimulationConfig::tendon`); e.g. compliant only where the tendon is long
+    /// against the fibre, as for the triceps surae.
+    pub tendon: Option<TendonModel>,
     /// A via point on the origin's body this far (m) above the insertion at rest: the
     /// quadriceps tendon runs down the trochlear groove onto the patella.
     pub via_above_insertion_m: Option<f64>,

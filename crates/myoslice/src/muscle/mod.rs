@@ -16,5 +16,6 @@ pub use dynamics::{ChainLoad, ChainScratch, EndForces};
 pub use excursion::{Axis, Pull};
 pub use hill::{FibreState, HillForce, HillParams};
 pub(crate) use snapshot::MuscleSnapshot;
+pub use tendon::TendonModel;
 pub use unit::{ChainOptions, MUSCLE_DENSITY, MuscleUnit};
 pub use wrap::{WrapCylinder, WrapPath};

@@ -60,6 +60,7 @@ impl MuscleSnapshot {
                 path_velocity,
                 force,
                 fibre,
+                tendon: _,
                 moment_arm,
                 current_moment_arm,
             } = m;

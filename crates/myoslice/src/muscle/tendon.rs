@@ -1,12 +1,49 @@
-//! A compliant tendon (De Groote et al. 2016): the fibre length becomes a state. Each step
+//! The tendon models, and a compliant tendon (De Groote et al. 2016): the fibre length becomes a state. Each step
 //! finds it by backward Euler: the fibre length at which the tendon, stretched by what the
 //! fibre leaves of the muscle-tendon length, pulls exactly as hard as the fibre does along
 //! it at the velocity that length implies.
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{Error, Result, parse_choice};
 
 use super::hill::{
     FibreState, HillParams, active_force_length_and_slope, force_velocity_and_slope,
     passive_force_length_and_slope, tendon_force_length, tendon_force_length_and_slope,
 };
+
+/// How the Hill units' tendons behave.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TendonModel {
+    /// Inextensible: the fibre takes every change of the muscle-tendon length.
+    #[default]
+    Rigid,
+    /// Elastic (De Groote 2016's tendon curve, about 4.7 % strain at max isometric
+    /// force): the fibre length is a state found by backward Euler every step.
+    Compliant,
+}
+
+impl TendonModel {
+    /// Every model, in the order fronts list them.
+    pub const ALL: [Self; 2] = [Self::Rigid, Self::Compliant];
+
+    /// The name used in scenarios, the CLI and Python (`"rigid"`, `"compliant"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Rigid => "rigid",
+            Self::Compliant => "compliant",
+        }
+    }
+}
+
+impl std::str::FromStr for TendonModel {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<Self> {
+        parse_choice("tendon", s, &Self::ALL, |m| m.name())
+    }
+}
 
 /// Iterations of the safeguarded Newton solve; it converges in a handful.
 const MAX_ITERATIONS: usize = 60;

@@ -7,6 +7,7 @@ use parry3d::shape::TriMesh;
 use super::catalogue::{MuscleCatalogue, MuscleGroup};
 use super::chain::{Attachment, BodyFrames, ConeAnchor, MuscleChain};
 use super::hill::{FibreState, HillParams};
+use super::tendon::TendonModel;
 use super::wrap::WrapCylinder;
 use crate::body::{BodyId, KneeAxis, body_of_bone};
 use crate::error::{Error, Result};
@@ -68,6 +69,9 @@ pub struct MuscleUnit {
     pub force: f64,
     /// Fibre state of the last step.
     pub fibre: FibreState,
+    /// Its tendon model (Hill mode): the catalogue's for this muscle, else the
+    /// simulation's default.
+    pub tendon: TendonModel,
     /// Moment arm about the knee (m), positive for flexion, of the last step (the one its
     /// force and the knee torque went with).
     pub moment_arm: f64,
@@ -93,6 +97,7 @@ impl Clone for MuscleUnit {
             path_velocity: self.path_velocity,
             force: self.force,
             fibre: self.fibre,
+            tendon: self.tendon,
             moment_arm: self.moment_arm,
             current_moment_arm: self.current_moment_arm,
         }
@@ -117,6 +122,7 @@ impl Clone for MuscleUnit {
             path_velocity,
             force,
             fibre,
+            tendon,
             moment_arm,
             current_moment_arm,
         } = o;
@@ -129,6 +135,7 @@ impl Clone for MuscleUnit {
         (self.excitation, self.activation, self.force) = (*excitation, *activation, *force);
         (self.path_length, self.path_velocity, self.fibre) = (*path_length, *path_velocity, *fibre);
         (self.moment_arm, self.current_moment_arm) = (*moment_arm, *current_moment_arm);
+        self.tendon = *tendon;
     }
 }
 
@@ -155,7 +162,8 @@ fn nearest_bone(meshes: &[&TriMesh], p: Vec3) -> Option<(usize, Vec3, u32)> {
 
 impl MuscleUnit {
     /// Builds the unit of lattice muscle `index`. `meshes` are the bone surfaces (lattice
-    /// bone order, rest coordinates).
+    /// bone order, rest coordinates); `default_tendon` is its tendon model unless the catalogue
+    /// gives it one.
     pub fn build(
         lattice: &Lattice,
         index: usize,
@@ -163,6 +171,7 @@ impl MuscleUnit {
         knee: &KneeAxis,
         catalogue: &MuscleCatalogue,
         opts: &ChainOptions,
+        default_tendon: TendonModel,
     ) -> Result<Self> {
         let m: &MuscleLattice = &lattice.muscles[index];
         let entry = catalogue.muscles.get(&m.name);
@@ -462,6 +471,7 @@ impl MuscleUnit {
             path_velocity: 0.0,
             force: 0.0,
             fibre,
+            tendon: entry.and_then(|e| e.tendon).unwrap_or(default_tendon),
             moment_arm: 0.0,
             current_moment_arm: 0.0,
         })

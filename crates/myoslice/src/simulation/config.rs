@@ -2,7 +2,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Result, check_positive, check_range};
+pub use crate::muscle::TendonModel;
+
+use crate::error::{Error, Result, check_positive, check_range, parse_choice};
 use crate::tissue::TissueConfig;
 
 /// Which muscle model drives the chains.
@@ -15,18 +17,6 @@ pub enum MuscleModel {
     /// The paper's spring chain: a contraction force proportional to excitation on damped
     /// springs of fixed rest length (Eq. 1).
     Spring,
-}
-
-/// How the Hill units' tendons behave.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum TendonModel {
-    /// Inextensible: the fibre takes every change of the muscle-tendon length.
-    #[default]
-    Rigid,
-    /// Elastic (De Groote 2016's tendon curve, about 4.7 % strain at max isometric
-    /// force): the fibre length is a state found by backward Euler every step.
-    Compliant,
 }
 
 impl MuscleModel {
@@ -48,44 +38,6 @@ impl std::str::FromStr for MuscleModel {
     fn from_str(s: &str) -> Result<Self> {
         parse_choice("muscle_model", s, &Self::ALL, |m| m.name())
     }
-}
-
-impl TendonModel {
-    /// Every model, in the order fronts list them.
-    pub const ALL: [Self; 2] = [Self::Rigid, Self::Compliant];
-
-    /// The name used in scenarios, the CLI and Python (`"rigid"`, `"compliant"`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Rigid => "rigid",
-            Self::Compliant => "compliant",
-        }
-    }
-}
-
-impl std::str::FromStr for TendonModel {
-    type Err = Error;
-
-    fn from_str(s: &str) -> Result<Self> {
-        parse_choice("tendon", s, &Self::ALL, |m| m.name())
-    }
-}
-
-/// The choice named `s` among `all`, or an error naming the option and the choices.
-fn parse_choice<T: Copy>(
-    option: &str,
-    s: &str,
-    all: &[T],
-    name: fn(T) -> &'static str,
-) -> Result<T> {
-    all.iter().copied().find(|&c| name(c) == s).ok_or_else(|| {
-        let names: Vec<String> = all.iter().map(|&c| format!("'{}'", name(c))).collect();
-        Error::invalid(
-            option,
-            format!("'{s}'"),
-            format!("expected {}", names.join(" or ")),
-        )
-    })
 }
 
 /// Options of a [`super::Simulation`]. Every field has a documented default.

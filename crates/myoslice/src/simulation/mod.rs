@@ -54,6 +54,8 @@ pub struct MuscleReadout {
     pub moment_arm: f64,
     /// Path length origin to insertion (m).
     pub path_length: f64,
+    /// Its tendon model (used in Hill mode).
+    pub tendon: TendonModel,
 }
 
 /// The dynamic state of a simulation, for checkpoints (`state` / `set_state`).
@@ -144,7 +146,9 @@ impl Simulation {
             gravity: Vec3::from_array(config.gravity.map(|g| g as f32)),
         };
         let muscles = (0..lattice.muscles.len())
-            .map(|i| MuscleUnit::build(&lattice, i, &meshes, &knee, catalogue, &opts))
+            .map(|i| {
+                MuscleUnit::build(&lattice, i, &meshes, &knee, catalogue, &opts, config.tendon)
+            })
             .collect::<Result<Vec<_>>>()?;
         let bones = config
             .tissue
@@ -440,6 +444,7 @@ impl Simulation {
             normalised_fibre_length: m.fibre.length / m.hill.optimal_fibre_length,
             moment_arm: m.moment_arm,
             path_length: m.path_length,
+            tendon: m.tendon,
         }
     }
 

@@ -1,6 +1,7 @@
 //! Switching the muscle and tendon models of a running simulation.
 
 use super::{MuscleModel, Simulation, TendonModel};
+use crate::error::Result;
 
 impl Simulation {
     /// The muscle model driving the chains now.
@@ -8,7 +9,9 @@ impl Simulation {
         self.config.muscle_model
     }
 
-    /// The Hill units' tendon model now.
+    /// The default tendon model: the one [`Self::set_tendon_model`] last gave every
+    /// muscle (or the configuration's). A muscle may have its own (the catalogue's
+    /// `tendon`, or [`Self::set_muscle_tendon`]); its readout says which.
     pub fn tendon_model(&self) -> TendonModel {
         self.config.tendon
     }
@@ -46,26 +49,59 @@ impl Simulation {
     /// sim.step(0.2)?;
     /// # Ok::<(), myoslice::Error>(())
     /// ```
+    ///
+    /// Every muscle takes it, those with a tendon of their own too; a muscle whose tendon
+    /// does not change keeps its fibre state.
     pub fn set_tendon_model(&mut self, tendon: TendonModel) {
-        if tendon != self.config.tendon {
-            self.config.tendon = tendon;
-            self.start_fibres();
+        self.config.tendon = tendon;
+        for i in 0..self.muscles.len() {
+            self.switch_tendon(i, tendon);
         }
     }
 
-    /// Every fibre in the state the current models give it at the current path: static
-    /// equilibrium for compliant Hill units, the rigid-tendon kinematics otherwise.
-    pub(super) fn start_fibres(&mut self) {
-        let compliant = self.config.tendon == TendonModel::Compliant
-            && self.config.muscle_model == MuscleModel::Hill;
-        for m in &mut self.muscles {
-            m.fibre = if compliant {
-                m.hill
-                    .compliant_tendon_step(m.activation, m.path_length, m.fibre.length, None)
-            } else {
-                m.hill
-                    .rigid_tendon_kinematics(m.path_length, m.path_velocity)
-            };
+    /// Gives one muscle its own tendon model mid-run (the others keep theirs and their
+    /// fibre states); its fibre starts as [`Self::set_tendon_model`] starts them.
+    ///
+    /// ```no_run
+    /// use myoslice::prelude::*;
+    /// let mut sim = Simulation::phantom(SimulationConfig::default())?;
+    /// sim.set_muscle_tendon("gastrocnemius_medial", TendonModel::Compliant)?;
+    /// assert_eq!(sim.muscle("gastrocnemius_medial")?.tendon, TendonModel::Compliant);
+    /// assert_eq!(sim.muscle("semitendinosus")?.tendon, TendonModel::Rigid);
+    /// # Ok::<(), myoslice::Error>(())
+    /// ```
+    pub fn set_muscle_tendon(&mut self, name: &str, tendon: TendonModel) -> Result<()> {
+        let i = self.muscle_index(name)?;
+        self.switch_tendon(i, tendon);
+        Ok(())
+    }
+
+    fn switch_tendon(&mut self, i: usize, tendon: TendonModel) {
+        if self.muscles[i].tendon != tendon {
+            self.muscles[i].tendon = tendon;
+            self.start_fibre(i);
         }
+    }
+
+    /// Every fibre in the state the current models give it at the current path (see
+    /// [`Self::start_fibre`]).
+    pub(super) fn start_fibres(&mut self) {
+        for i in 0..self.muscles.len() {
+            self.start_fibre(i);
+        }
+    }
+
+    /// Muscle `i`'s fibre in the state the current models give it at the current path:
+    /// static equilibrium for a compliant Hill unit, the rigid-tendon kinematics otherwise.
+    fn start_fibre(&mut self, i: usize) {
+        let hill = self.config.muscle_model == MuscleModel::Hill;
+        let m = &mut self.muscles[i];
+        m.fibre = if hill && m.tendon == TendonModel::Compliant {
+            m.hill
+                .compliant_tendon_step(m.activation, m.path_length, m.fibre.length, None)
+        } else {
+            m.hill
+                .rigid_tendon_kinematics(m.path_length, m.path_velocity)
+        };
     }
 }

@@ -126,7 +126,6 @@ impl Simulation {
         let gravity = self.skeleton.gravity();
         let knee = *self.skeleton.knee();
         let hill = self.config.muscle_model == MuscleModel::Hill;
-        let compliant = self.config.tendon == TendonModel::Compliant;
         let (mut forces, mut loads) = std::mem::take(&mut self.scratch);
         forces.clear();
         loads.clear();
@@ -156,7 +155,7 @@ impl Simulation {
                 continue;
             }
             let (tension, ends) = if hill {
-                m.fibre = if compliant {
+                m.fibre = if m.tendon == TendonModel::Compliant {
                     m.hill.compliant_tendon_step(
                         m.activation,
                         m.path_length,
