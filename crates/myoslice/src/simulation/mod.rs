@@ -289,7 +289,7 @@ impl Simulation {
 
     /// Tissue metrics of the last tissue update (None when tissue is disabled).
     pub fn tissue_metrics(&self) -> Option<&TissueMetrics> {
-        self.tissue.as_ref().map(|t| &t.metrics)
+        self.tissue.as_ref().map(Tissue::metrics)
     }
 
     /// How far each muscle's surface reaches into bone now, in muscle order (exact: a

@@ -1,5 +1,7 @@
 //! Per-element and whole-body tissue metrics (paper, section 5.3 and Eq. 5).
 
+use std::sync::OnceLock;
+
 use glam::{Mat3, Vec3};
 
 use super::Tissue;
@@ -101,5 +103,49 @@ impl TissueMetrics {
             inverted,
             guarded_vertices: 0,
         }
+    }
+}
+
+/// The metrics of a tissue's last update, measured when first asked for: a run that never
+/// reads them (a benchmark, a controller's training) does not pay for them, and one that
+/// does gets the same values as if they had been measured at the update.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct LazyMetrics {
+    measured: OnceLock<TissueMetrics>,
+    /// Whether every element is measured (the built tissue), or only those the last
+    /// update relaxed.
+    every_element: bool,
+    /// Fat vertices the guard moved in the last update.
+    guarded: usize,
+}
+
+impl LazyMetrics {
+    /// Of a tissue as built.
+    pub(crate) fn built() -> Self {
+        Self {
+            every_element: true,
+            ..Self::default()
+        }
+    }
+
+    /// Of an update whose guard moved `guarded` vertices.
+    pub(crate) fn updated(guarded: usize) -> Self {
+        Self {
+            guarded,
+            ..Self::default()
+        }
+    }
+
+    /// The metrics of `t`, the tissue these belong to (measured on the first call).
+    pub(crate) fn of<'a>(&'a self, t: &Tissue) -> &'a TissueMetrics {
+        self.measured.get_or_init(|| {
+            let mut m = if self.every_element {
+                TissueMetrics::measure(t)
+            } else {
+                TissueMetrics::measure_active(t)
+            };
+            m.guarded_vertices = self.guarded;
+            m
+        })
     }
 }

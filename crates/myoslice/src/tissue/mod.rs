@@ -23,6 +23,7 @@ use serde::{Deserialize, Serialize};
 
 pub use fat_solver::FatSolver;
 pub use knee_fold::{Contact, FoldZone, KneeFold};
+use metrics::LazyMetrics;
 pub use metrics::TissueMetrics;
 pub use muscle_shape::MuscleShape;
 
@@ -169,8 +170,8 @@ pub struct Tissue {
     knee: KneeAxis,
     theta: f32,
     layers: usize,
-    /// Metrics at the last update.
-    pub metrics: TissueMetrics,
+    /// Metrics of the last update (see [`Self::metrics`]).
+    metrics: LazyMetrics,
     /// Time accumulated since the last update (s).
     pub(crate) pending: f64,
 }
@@ -184,7 +185,7 @@ pub(crate) struct TissueBackup {
     fat_active: Vec<bool>,
     drift: Vec<Vec3>,
     theta: f32,
-    metrics: TissueMetrics,
+    metrics: LazyMetrics,
     bone_slide: BoneSlide,
     muscles: Vec<(Vec<Vec3>, f64, KeepOutMemory)>,
 }
@@ -266,7 +267,7 @@ impl Tissue {
             bones: Arc::clone(&bones),
             outer_faces,
         };
-        let mut tissue = Self {
+        let tissue = Self {
             config,
             muscles: shapes,
             drift: vec![Vec3::ZERO; nv],
@@ -277,11 +278,17 @@ impl Tissue {
             knee,
             theta: 0.0,
             layers: fat.layers,
-            metrics: TissueMetrics::default(),
+            metrics: LazyMetrics::built(),
             pending: 0.0,
         };
-        tissue.metrics = TissueMetrics::measure(&tissue);
         Ok(tissue)
+    }
+
+    /// Metrics of the last update (of the rest shape before any), measured when first
+    /// asked for, from the shape that update left (moving `fat` or `muscles` by hand in
+    /// between changes what they describe).
+    pub fn metrics(&self) -> &TissueMetrics {
+        self.metrics.of(self)
     }
 
     /// The options.
@@ -534,8 +541,7 @@ impl Tissue {
         }
         self.theta = theta;
         self.scratch = sc;
-        self.metrics = TissueMetrics::measure_active(self);
-        self.metrics.guarded_vertices = guarded;
+        self.metrics = LazyMetrics::updated(guarded);
     }
 
     /// Pulls inner vertices facing a muscle toward their targets (the paper's rule, see
