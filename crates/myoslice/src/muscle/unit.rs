@@ -237,13 +237,15 @@ impl MuscleUnit {
             None => site(ob, o_end, entry.and_then(|e| e.origin_site.as_ref())),
         };
         let i_site = entry.and_then(|e| e.insertion_site.as_ref());
-        let i_att = match entry.and_then(|e| e.insertion_below_knee_m) {
-            _ if i_site.is_some_and(|s| s == "anteromedial") => {
-                let below = entry.and_then(|e| e.insertion_below_knee_m).unwrap_or(0.0);
-                anteromedial(lattice, ib, knee, below as f32).unwrap_or_else(|| project(ib, i_end))
+        let below = entry.and_then(|e| e.insertion_below_knee_m);
+        let i_att = if i_site.is_some_and(|s| s == "anteromedial") {
+            let d = below.unwrap_or(0.0) as f32;
+            anteromedial(lattice, ib, knee, d).unwrap_or_else(|| project(ib, i_end))
+        } else {
+            match below {
+                Some(d) => beyond(ib, i_end, -d as f32),
+                None => site(ib, i_end, i_site),
             }
-            Some(d) => beyond(ib, i_end, -d as f32),
-            None => site(ib, i_end, i_site),
         };
         let belly_len: f64 = belly
             .windows(2)

@@ -39,7 +39,9 @@ impl Simulation {
     /// Switches the Hill units' tendons mid-run. To compliant, every fibre starts in
     /// static equilibrium with its tendon at the current path length and activation (a
     /// step from the rigid fibre length would read the tendon's stretch as a fibre
-    /// velocity); to rigid, the fibre takes the whole path again.
+    /// velocity); to rigid, the fibre takes the whole path again. Every muscle takes it,
+    /// those with a tendon of their own too; a muscle whose tendon does not change keeps
+    /// its fibre state.
     ///
     /// ```no_run
     /// use myoslice::prelude::*;
@@ -49,9 +51,6 @@ impl Simulation {
     /// sim.step(0.2)?;
     /// # Ok::<(), myoslice::Error>(())
     /// ```
-    ///
-    /// Every muscle takes it, those with a tendon of their own too; a muscle whose tendon
-    /// does not change keeps its fibre state.
     pub fn set_tendon_model(&mut self, tendon: TendonModel) {
         self.config.tendon = tendon;
         for i in 0..self.muscles.len() {
