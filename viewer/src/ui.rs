@@ -337,7 +337,7 @@ impl UiState {
     }
 
     fn muscles(&mut self, ui: &mut egui::Ui, sim: &mut Simulation, _actions: &mut Vec<UiAction>) {
-        crate::model_switch::show(ui, sim);
+        crate::model_switch::show(ui, sim, self.selected);
         ui.label("Excitation");
         for (group, title) in [
             (MuscleGroup::Flexor, "Flexors"),
