@@ -12,7 +12,7 @@ use myoslice::muscle::hill::{
 use myoslice::muscle::{MuscleCatalogue, MuscleGroup};
 use myoslice::prelude::*;
 
-use common::{HAMSTRINGS, QUADRICEPS, group_moment_arm, phantom_lattice};
+use common::{HAMSTRINGS, QUADRICEPS, assert_moment_arms_in_published_ranges, phantom_lattice};
 
 fn config() -> SimulationConfig {
     let mut c = SimulationConfig::default();
@@ -297,24 +297,7 @@ fn activation_rises_and_falls_with_the_published_time_constants() {
 
 #[test]
 fn moment_arms_lie_in_published_human_ranges() {
-    // Published knee moment arms (e.g. Buford et al. 1997, Herzog & Read 1993, Spoor &
-    // van Leeuwen 1992): hamstrings about 2-4 cm, quadriceps 3-5 cm.
-    let base = sim(config());
-    let mut report = String::new();
-    for deg in [0.0, 30.0, 60.0, 90.0, 120.0] {
-        let flex = group_moment_arm(&base, &HAMSTRINGS, deg) * 100.0;
-        let ext = -group_moment_arm(&base, &QUADRICEPS, deg) * 100.0;
-        report += &format!("{deg:>5.0}°: hamstrings {flex:.2} cm, quadriceps {ext:.2} cm\n");
-        assert!(
-            (2.0..=4.5).contains(&flex),
-            "hamstrings moment arm {flex:.2} cm at {deg}°\n{report}"
-        );
-        assert!(
-            (3.0..=5.0).contains(&ext),
-            "quadriceps moment arm {ext:.2} cm at {deg}°\n{report}"
-        );
-    }
-    println!("{report}");
+    println!("{}", assert_moment_arms_in_published_ranges(&sim(config())));
 }
 
 #[test]

@@ -188,25 +188,20 @@ impl MuscleCatalogue {
             }
         }
         for (name, e) in &cat.muscles {
-            for (key, v) in [
-                ("origin_site", &e.origin_site),
-                ("insertion_site", &e.insertion_site),
+            // The pes anserinus is an insertion site only.
+            const SITES: [&str; 4] = ["nearest", "superior", "inferior", "anteromedial"];
+            for (key, v, allowed) in [
+                ("origin_site", &e.origin_site, &SITES[..3]),
+                ("insertion_site", &e.insertion_site, &SITES[..]),
             ] {
-                // The pes anserinus is an insertion site only.
-                let anteromedial = key == "insertion_site" && v.as_deref() == Some("anteromedial");
                 if let Some(v) = v
-                    && !anteromedial
-                    && !matches!(v.as_str(), "nearest" | "superior" | "inferior")
+                    && !allowed.contains(&v.as_str())
                 {
-                    let also = if key == "insertion_site" {
-                        ", anteromedial"
-                    } else {
-                        ""
-                    };
                     return Err(Error::Parse {
                         path: origin.into(),
                         reason: format!(
-                            "muscle.{name}.{key} = '{v}': expected nearest, superior, inferior{also}"
+                            "muscle.{name}.{key} = '{v}': expected {}",
+                            allowed.join(", ")
                         ),
                     });
                 }

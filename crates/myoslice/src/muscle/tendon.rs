@@ -1,7 +1,7 @@
-//! The tendon models, and a compliant tendon (De Groote et al. 2016): the fibre length becomes a state. Each step
-//! finds it by backward Euler: the fibre length at which the tendon, stretched by what the
-//! fibre leaves of the muscle-tendon length, pulls exactly as hard as the fibre does along
-//! it at the velocity that length implies.
+//! The tendon models, and a compliant tendon (De Groote et al. 2016): the fibre length
+//! becomes a state. Each step finds it by backward Euler: the fibre length at which the
+//! tendon, stretched by what the fibre leaves of the muscle-tendon length, pulls exactly
+//! as hard as the fibre does along it at the velocity that length implies.
 
 use serde::{Deserialize, Serialize};
 

@@ -58,12 +58,32 @@ pub fn group_moment_arm(base: &Simulation, names: &[&str], deg: f64) -> f64 {
     s.set_knee(deg.to_radians(), 0.0).unwrap();
     let (mut num, mut den) = (0.0, 0.0);
     for m in names {
-        let i = s.muscle_index(m).unwrap();
-        let f = s.muscles()[i].hill.max_isometric_force;
-        num += f * s.muscle(m).unwrap().moment_arm;
-        den += f;
+        let u = &s.muscles()[s.muscle_index(m).unwrap()];
+        num += u.hill.max_isometric_force * u.moment_arm;
+        den += u.hill.max_isometric_force;
     }
     num / den
+}
+
+/// Checks the hamstring and quadriceps group moment arms of `base` over 0-120° against
+/// the published human ranges (e.g. Buford et al. 1997, Herzog & Read 1993, Spoor & van
+/// Leeuwen 1992: hamstrings about 2-4 cm, quadriceps 3-5 cm) and returns the table.
+pub fn assert_moment_arms_in_published_ranges(base: &Simulation) -> String {
+    let mut report = String::new();
+    for deg in [0.0, 30.0, 60.0, 90.0, 120.0] {
+        let flex = group_moment_arm(base, &HAMSTRINGS, deg) * 100.0;
+        let ext = -group_moment_arm(base, &QUADRICEPS, deg) * 100.0;
+        report += &format!("{deg:>5.0}°: hamstrings {flex:.2} cm, quadriceps {ext:.2} cm\n");
+        assert!(
+            (2.0..=4.5).contains(&flex),
+            "hamstrings moment arm {flex:.2} cm at {deg}°\n{report}"
+        );
+        assert!(
+            (3.0..=5.0).contains(&ext),
+            "quadriceps moment arm {ext:.2} cm at {deg}°\n{report}"
+        );
+    }
+    report
 }
 
 /// The phantom's lattice, built once per test binary.
