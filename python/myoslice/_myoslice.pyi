@@ -35,6 +35,12 @@ class _MusclesInBone(TypedDict):
     vertices_over_1mm: npt.NDArray[np.int64]
     deepest_m: npt.NDArray[np.float32]
 
+class _MusclesOutsideSkin(TypedDict):
+    """What :meth:`Simulation.muscles_outside_skin` returns, one entry per muscle."""
+
+    vertices_over_1mm: npt.NDArray[np.int64]
+    farthest_m: npt.NDArray[np.float32]
+
 @final
 class State:
     """An opaque checkpoint of a :class:`Simulation` (``Simulation.state()``)."""
@@ -216,6 +222,13 @@ class Simulation:
         order: ``vertices_over_1mm`` (int64, vertices more than 1 mm inside a bone) and
         ``deepest_m`` (float32, m); empty arrays without tissue. Exact (a tree query per
         vertex near a bone): tens of milliseconds, for checks rather than every frame."""
+
+    def muscles_outside_skin(self) -> _MusclesOutsideSkin:
+        """How far each muscle's surface reaches out through the skin now, in
+        :attr:`muscle_names` order: ``vertices_over_1mm`` (int64, vertices more than 1 mm
+        outside the skin) and ``farthest_m`` (float32, m); empty arrays without tissue.
+        Exact (the skin closed at both ends, a tree query per muscle vertex): tens of
+        milliseconds, for checks rather than every frame."""
 
     @property
     def n_fat_elements(self) -> int:

@@ -494,6 +494,20 @@ impl PySimulation {
         Ok(d)
     }
 
+    /// How far each muscle's surface reaches out through the skin now: a dict of
+    /// per-muscle arrays `vertices_over_1mm` (int64) and `farthest_m` (float32), empty
+    /// without tissue.
+    fn muscles_outside_skin<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let sim = &self.sim;
+        let o = py.detach(|| sim.muscles_outside_skin()).unwrap_or_default();
+        let d = PyDict::new(py);
+        let count: Vec<i64> = o.iter().map(|b| b.vertices_over_1mm as i64).collect();
+        let farthest: Vec<f32> = o.iter().map(|b| b.farthest_m).collect();
+        d.set_item("vertices_over_1mm", PyArray1::from_vec(py, count))?;
+        d.set_item("farthest_m", PyArray1::from_vec(py, farthest))?;
+        Ok(d)
+    }
+
     /// Number of fat elements (hexahedra).
     #[getter]
     fn n_fat_elements(&self) -> usize {

@@ -233,6 +233,24 @@ def test_muscles_in_bone_per_muscle(tissue: Simulation, rigid: Simulation) -> No
     assert empty["vertices_over_1mm"].shape == (0,) and empty["deepest_m"].shape == (0,)
 
 
+def test_muscles_outside_skin_per_muscle(tissue: Simulation, rigid: Simulation) -> None:
+    # At rest every muscle lies under the skin.
+    r = tissue.muscles_outside_skin()
+    assert set(r) == {"vertices_over_1mm", "farthest_m"}
+    count, farthest = r["vertices_over_1mm"], r["farthest_m"]
+    n = len(tissue.muscle_names)
+    assert count.shape == (n,) and count.dtype == np.int64
+    assert farthest.shape == (n,) and farthest.dtype == np.float32
+    assert (count == 0).all() and (farthest < 1e-3).all()
+    flex(tissue, 0.3)
+    r = tissue.muscles_outside_skin()
+    count, farthest = r["vertices_over_1mm"], r["farthest_m"]
+    assert (count >= 0).all() and np.isfinite(farthest).all()
+    assert ((farthest > 1e-3) == (count > 0)).all()
+    empty = rigid.muscles_outside_skin()
+    assert empty["vertices_over_1mm"].shape == (0,) and empty["farthest_m"].shape == (0,)
+
+
 def test_set_excitation_single(rigid: Simulation) -> None:
     rigid.set_excitation("semimembranosus", 0.25)
     e = rigid.excitations

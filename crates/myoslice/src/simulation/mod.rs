@@ -25,7 +25,7 @@ use crate::lattice::{BuildOptions, Lattice};
 use crate::muscle::{
     Axis, BodyFrames, ChainLoad, ChainOptions, MuscleCatalogue, MuscleGroup, MuscleUnit,
 };
-use crate::tissue::{BoneOverlap, Tissue, TissueMetrics, bone_surfaces};
+use crate::tissue::{BoneOverlap, SkinBreach, Tissue, TissueMetrics, bone_surfaces};
 
 /// Simulated time (s) the muscle chains settle at rest before time 0 (see `settle`).
 const SETTLE_S: f64 = 2.0;
@@ -299,6 +299,13 @@ impl Simulation {
         self.tissue
             .as_ref()
             .map(|t| t.muscles_in_bone(&self.frames))
+    }
+
+    /// How far each muscle's surface reaches out through the skin now, in muscle order
+    /// (exact: a tree query per muscle vertex, tens of milliseconds; for checks, not every
+    /// frame). None when tissue is disabled.
+    pub fn muscles_outside_skin(&self) -> Option<Vec<SkinBreach>> {
+        self.tissue.as_ref().and_then(|t| t.muscles_outside_skin())
     }
 
     /// Wall-clock time spent in `step` since the build or `reset_timers`.

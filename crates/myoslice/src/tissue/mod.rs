@@ -13,6 +13,7 @@ pub mod knee_fold;
 pub mod metrics;
 pub mod muscle_shape;
 pub mod polar;
+mod skin_breach;
 
 use std::sync::Arc;
 
@@ -26,6 +27,8 @@ pub use knee_fold::{Contact, FoldZone, KneeFold};
 use metrics::LazyMetrics;
 pub use metrics::TissueMetrics;
 pub use muscle_shape::MuscleShape;
+use skin_breach::ClosedSkin;
+pub use skin_breach::SkinBreach;
 
 use crate::body::{BodyId, KneeAxis, body_of_bone};
 use crate::error::{Result, check_range};
@@ -129,6 +132,8 @@ struct TissueStatic {
     bones: BoneSurfaces,
     /// Outer (skin) face of each outer-layer element and its rest area (m²).
     outer_faces: Vec<(u32, [u32; 4], f64)>,
+    /// The skin closed at both ends (for [`Tissue::muscles_outside_skin`]).
+    skin: ClosedSkin,
 }
 
 /// Buffers an update fills anew each time, kept to avoid allocating them. A copy of the
@@ -266,6 +271,7 @@ impl Tissue {
             bone_meshes,
             bones: Arc::clone(&bones),
             outer_faces,
+            skin: ClosedSkin::new(fat),
         };
         let tissue = Self {
             config,
@@ -315,6 +321,14 @@ impl Tissue {
             .par_iter()
             .map(|m| bone_keep_out::overlap(&m.current, &bones))
             .collect()
+    }
+
+    /// How far each muscle's surface reaches out through the skin now, in muscle order
+    /// (exact: the skin closed at both ends of the lattice, a tree query per muscle
+    /// vertex; for checks, not for every update). None when the skin is degenerate.
+    pub fn muscles_outside_skin(&self) -> Option<Vec<SkinBreach>> {
+        let muscles: Vec<&[Vec3]> = self.muscles.iter().map(|m| m.current.as_slice()).collect();
+        self.fixed.skin.breaches(&self.fat.x, &muscles)
     }
 
     /// Outer (skin) face of each outer-layer element, with its rest area (m²).

@@ -1,0 +1,114 @@
+//! Muscles that reach out through the skin: the body surface closed at both ends of the
+//! lattice, and each muscle vertex measured against it (exact: a tree query per vertex;
+//! for checks, not for every update).
+
+use glam::Vec3;
+use parry3d::query::PointQuery;
+use rayon::prelude::*;
+
+use crate::lattice::{FatLattice, oriented_trimesh};
+
+/// How far a muscle's surface reaches out through the skin (see
+/// [`super::Tissue::muscles_outside_skin`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SkinBreach {
+    /// Muscle vertices more than 1 mm outside the skin.
+    pub vertices_over_1mm: usize,
+    /// Farthest muscle vertex outside the skin (m), 0 when none is.
+    pub farthest_m: f32,
+}
+
+/// The skin as a closed surface: the outer faces of the fat and a fan over each end.
+#[derive(Debug, Clone)]
+pub(crate) struct ClosedSkin {
+    /// Fat vertices on the skin, in the closed surface's vertex order (the two end
+    /// centres follow them).
+    used: Vec<u32>,
+    /// Triangles over `used` and the two end centres, oriented outward.
+    triangles: Vec<[u32; 3]>,
+    /// Positions in `used` of the outer ring of the first and last slice.
+    ends: [Vec<u32>; 2],
+}
+
+impl ClosedSkin {
+    /// The closed skin of a fat lattice.
+    pub(crate) fn new(fat: &FatLattice) -> Self {
+        let skin = fat.surface_triangles();
+        let mut slot = vec![u32::MAX; fat.vertices.len()];
+        let mut used = Vec::new();
+        let mut index = |v: u32| {
+            let s = &mut slot[v as usize];
+            if *s == u32::MAX {
+                *s = used.len() as u32;
+                used.push(v);
+            }
+            *s
+        };
+        let mut triangles: Vec<[u32; 3]> = skin.iter().map(|t| t.map(&mut index)).collect();
+        let ring = |s: usize| -> Vec<u32> {
+            (0..fat.rays)
+                .map(|j| fat.vertex_index(s, j, fat.layers))
+                .collect()
+        };
+        let ends: [Vec<u32>; 2] =
+            [ring(0), ring(fat.slices - 1)].map(|r| r.into_iter().map(&mut index).collect());
+        let n = used.len() as u32;
+        for (e, end) in ends.iter().enumerate() {
+            let centre = n + e as u32;
+            triangles.extend((0..end.len()).map(|j| [centre, end[j], end[(j + 1) % end.len()]]));
+        }
+        Self {
+            used,
+            triangles,
+            ends,
+        }
+    }
+
+    /// How far each of `muscles` (vertex lists) reaches out through the skin with the fat
+    /// vertices at `fat_x`. None when the skin is degenerate.
+    pub(crate) fn breaches(&self, fat_x: &[Vec3], muscles: &[&[Vec3]]) -> Option<Vec<SkinBreach>> {
+        let mut v: Vec<Vec3> = self.used.iter().map(|&i| fat_x[i as usize]).collect();
+        let centres = self
+            .ends
+            .each_ref()
+            .map(|r| r.iter().map(|&i| v[i as usize]).sum::<Vec3>() / r.len().max(1) as f32);
+        v.extend(centres);
+        // Face each end fan away from the other end.
+        let mut tri = self.triangles.clone();
+        let n_side = tri.len() - self.ends[0].len() - self.ends[1].len();
+        let mut start = n_side;
+        for (e, end) in self.ends.iter().enumerate() {
+            let fan = &mut tri[start..start + end.len()];
+            let out = centres[e] - centres[1 - e];
+            let normal: Vec3 = fan
+                .iter()
+                .map(|t| {
+                    let [a, b, c] = t.map(|i| v[i as usize]);
+                    (b - a).cross(c - a)
+                })
+                .sum();
+            if normal.dot(out) < 0.0 {
+                fan.iter_mut().for_each(|t| t.swap(1, 2));
+            }
+            start += end.len();
+        }
+        let mesh = oriented_trimesh(&v, &tri)?;
+        Some(
+            muscles
+                .par_iter()
+                .map(|m| {
+                    let mut b = SkinBreach::default();
+                    for &p in *m {
+                        let proj = mesh.project_local_point(p, false);
+                        if !proj.is_inside {
+                            let d = proj.point.distance(p);
+                            b.farthest_m = b.farthest_m.max(d);
+                            b.vertices_over_1mm += usize::from(d > 1e-3);
+                        }
+                    }
+                    b
+                })
+                .collect(),
+        )
+    }
+}
