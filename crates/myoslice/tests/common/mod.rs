@@ -86,6 +86,15 @@ pub fn assert_moment_arms_in_published_ranges(base: &Simulation) -> String {
     report
 }
 
+/// The Visible Human leg's lattice (None without the data), built once per test binary.
+pub fn vh_lattice() -> Option<&'static Lattice> {
+    static L: OnceLock<Option<Lattice>> = OnceLock::new();
+    L.get_or_init(|| {
+        vh_leg().map(|(v, t)| Lattice::build(&v, &t, &BuildOptions::default()).unwrap())
+    })
+    .as_ref()
+}
+
 /// The phantom's lattice, built once per test binary.
 pub fn phantom_lattice() -> &'static Lattice {
     static L: OnceLock<Lattice> = OnceLock::new();
