@@ -442,8 +442,14 @@ fn muscles_reach_out_through_the_skin_no_further_than_recorded_in_a_deep_flexion
     flex_and_back(&mut sim, 1.0, |s| {
         let out = s.muscles_outside_skin().unwrap();
         let count: usize = out.iter().map(|b| b.vertices_over_1mm).sum();
+        let far = out.iter().map(|b| b.farthest_m).fold(0.0, f32::max);
+        eprintln!(
+            "{:6.1}°: {count} muscle vertices > 1 mm outside the skin, the farthest {:.1} mm",
+            s.knee_angle().to_degrees(),
+            far * 1e3
+        );
         most = most.max(count);
-        farthest = out.iter().map(|b| b.farthest_m).fold(farthest, f32::max);
+        farthest = farthest.max(far);
         if s.knee_angle().to_degrees() < 70.0 {
             below_70 = below_70.max(count);
         }
