@@ -303,7 +303,7 @@ impl Simulation {
 
     /// How far each muscle's surface reaches out through the skin now, in muscle order
     /// (exact: a tree query per muscle vertex, tens of milliseconds; for checks, not every
-    /// frame). None when tissue is disabled.
+    /// frame). None when tissue is disabled (or its skin cannot be closed into a mesh).
     pub fn muscles_outside_skin(&self) -> Option<Vec<SkinBreach>> {
         self.tissue.as_ref().and_then(|t| t.muscles_outside_skin())
     }
