@@ -541,13 +541,20 @@ impl ApplicationHandler for App {
 }
 
 /// `new` with the muscle and tendon models `old` runs now: the panel's choice outlives a
-/// reset or a load (the source's own models are only where a session starts).
+/// reset or a load (the source's own models are only where a session starts), a muscle's
+/// own tendon included.
 fn with_models_of(mut new: Simulation, old: &Simulation) -> Simulation {
     new.set_muscle_model(old.muscle_model());
     // Only a changed default: the global switch would override tendons the catalogue
     // gives single muscles.
     if new.tendon_model() != old.tendon_model() {
         new.set_tendon_model(old.tendon_model());
+    }
+    // Muscles with a tendon of their own now keep it, where the new one has the muscle.
+    for m in old.muscles() {
+        if m.tendon != old.tendon_model() {
+            let _ = new.set_muscle_tendon(&m.name, m.tendon);
+        }
     }
     new
 }
@@ -566,5 +573,24 @@ mod tests {
         let new = with_models_of(Simulation::phantom(config).expect("phantom"), &old);
         assert_eq!(new.muscle_model(), MuscleModel::Spring);
         assert_eq!(new.tendon_model(), TendonModel::Compliant);
+    }
+
+    #[test]
+    fn a_reset_keeps_a_muscle_s_own_tendon() {
+        let mut config = SimulationConfig::default();
+        config.tissue.enabled = false;
+        let mut old = Simulation::phantom(config.clone()).expect("phantom");
+        old.set_muscle_tendon("semitendinosus", TendonModel::Compliant)
+            .expect("a catalogued muscle");
+        let new = with_models_of(Simulation::phantom(config).expect("phantom"), &old);
+        assert_eq!(new.tendon_model(), TendonModel::Rigid);
+        for m in new.muscles() {
+            let want = if m.name == "semitendinosus" {
+                TendonModel::Compliant
+            } else {
+                TendonModel::Rigid
+            };
+            assert_eq!(m.tendon, want, "{}", m.name);
+        }
     }
 }
