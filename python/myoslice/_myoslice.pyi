@@ -226,7 +226,8 @@ class Simulation:
     def muscles_outside_skin(self) -> _MusclesOutsideSkin:
         """How far each muscle's surface reaches out through the skin now, in
         :attr:`muscle_names` order: ``vertices_over_1mm`` (int64, vertices more than 1 mm
-        outside the skin) and ``farthest_m`` (float32, m); empty arrays without tissue.
+        outside the skin) and ``farthest_m`` (float32, m); empty arrays without tissue
+        (or where the skin cannot be closed into a mesh).
         Exact (the skin closed at both ends, a tree query per muscle vertex): tens of
         milliseconds, for checks rather than every frame."""
 

@@ -496,7 +496,7 @@ impl PySimulation {
 
     /// How far each muscle's surface reaches out through the skin now: a dict of
     /// per-muscle arrays `vertices_over_1mm` (int64) and `farthest_m` (float32), empty
-    /// without tissue.
+    /// without tissue (or where the skin cannot be closed into a mesh).
     fn muscles_outside_skin<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let sim = &self.sim;
         let o = py.detach(|| sim.muscles_outside_skin()).unwrap_or_default();
