@@ -8,6 +8,7 @@ use myoslice::tissue::TissueMetrics;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use crate::errors::{Kind, py_err};
 
@@ -25,6 +26,20 @@ pub(crate) fn metric_array<'py>(
         sim.tissue_metrics()
             .map_or_else(Vec::new, |m| pick(m).clone()),
     )
+}
+
+/// How far muscles reach where they should not, as a dict of per-muscle arrays:
+/// `vertices_over_1mm` (int64) and one distance (float32, m) under its own name.
+pub(crate) fn per_muscle_reach<'py>(
+    py: Python<'py>,
+    count: Vec<usize>,
+    (name, distance): (&str, Vec<f32>),
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let count: Vec<i64> = count.into_iter().map(|c| c as i64).collect();
+    d.set_item("vertices_over_1mm", PyArray1::from_vec(py, count))?;
+    d.set_item(name, PyArray1::from_vec(py, distance))?;
+    Ok(d)
 }
 
 pub(crate) fn check_path(py: Python<'_>, p: &Path, what: &str) -> PyResult<()> {

@@ -16,7 +16,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray3, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use arrays::{SurfaceArrays, check_path, metric_array, tri_array, vec3_array};
+use arrays::{SurfaceArrays, check_path, metric_array, per_muscle_reach, tri_array, vec3_array};
 use errors::{Kind, OrPy, py_err};
 
 /// A checkpoint of a simulation (`Simulation.state()` / `set_state()`).
@@ -486,12 +486,8 @@ impl PySimulation {
     fn muscles_in_bone<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let sim = &self.sim;
         let o = py.detach(|| sim.muscles_in_bone()).unwrap_or_default();
-        let d = PyDict::new(py);
-        let count: Vec<i64> = o.iter().map(|b| b.vertices_over_1mm as i64).collect();
-        let deepest: Vec<f32> = o.iter().map(|b| b.deepest_m).collect();
-        d.set_item("vertices_over_1mm", PyArray1::from_vec(py, count))?;
-        d.set_item("deepest_m", PyArray1::from_vec(py, deepest))?;
-        Ok(d)
+        let (count, deepest) = o.iter().map(|b| (b.vertices_over_1mm, b.deepest_m)).unzip();
+        per_muscle_reach(py, count, ("deepest_m", deepest))
     }
 
     /// How far each muscle's surface reaches out through the skin now: a dict of
@@ -500,12 +496,11 @@ impl PySimulation {
     fn muscles_outside_skin<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let sim = &self.sim;
         let o = py.detach(|| sim.muscles_outside_skin()).unwrap_or_default();
-        let d = PyDict::new(py);
-        let count: Vec<i64> = o.iter().map(|b| b.vertices_over_1mm as i64).collect();
-        let farthest: Vec<f32> = o.iter().map(|b| b.farthest_m).collect();
-        d.set_item("vertices_over_1mm", PyArray1::from_vec(py, count))?;
-        d.set_item("farthest_m", PyArray1::from_vec(py, farthest))?;
-        Ok(d)
+        let (count, farthest) = o
+            .iter()
+            .map(|b| (b.vertices_over_1mm, b.farthest_m))
+            .unzip();
+        per_muscle_reach(py, count, ("farthest_m", farthest))
     }
 
     /// Number of fat elements (hexahedra).
