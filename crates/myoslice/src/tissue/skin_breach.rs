@@ -24,7 +24,8 @@ pub(crate) struct ClosedSkin {
     /// Fat vertices on the skin, in the closed surface's vertex order (the two end
     /// centres follow them).
     used: Vec<u32>,
-    /// Triangles over `used` and the two end centres, oriented outward.
+    /// Triangles over `used` and the two end centres, oriented outward (the end fans as
+    /// the rest shape faces them).
     triangles: Vec<[u32; 3]>,
     /// Positions in `used` of the outer ring of the first and last slice.
     ends: [Vec<u32>; 2],
@@ -53,9 +54,26 @@ impl ClosedSkin {
         let ends: [Vec<u32>; 2] =
             [ring(0), ring(fat.slices - 1)].map(|r| r.into_iter().map(&mut index).collect());
         let n = used.len() as u32;
+        // Each end fan faces away from the other end (the ends never swap places, so the
+        // rest shape settles it for good).
+        let centres = ends.each_ref().map(|r| {
+            r.iter()
+                .map(|&i| fat.vertices[used[i as usize] as usize])
+                .sum::<Vec3>()
+                / r.len().max(1) as f32
+        });
         for (e, end) in ends.iter().enumerate() {
             let centre = n + e as u32;
-            triangles.extend((0..end.len()).map(|j| [centre, end[j], end[(j + 1) % end.len()]]));
+            let out = centres[e] - centres[1 - e];
+            let at = |i: u32| fat.vertices[used[i as usize] as usize];
+            let normal: Vec3 = (0..end.len())
+                .map(|j| (at(end[j]) - centres[e]).cross(at(end[(j + 1) % end.len()]) - centres[e]))
+                .sum();
+            let flip = normal.dot(out) < 0.0;
+            triangles.extend((0..end.len()).map(|j| {
+                let (a, b) = (end[j], end[(j + 1) % end.len()]);
+                if flip { [centre, b, a] } else { [centre, a, b] }
+            }));
         }
         Self {
             used,
@@ -73,26 +91,7 @@ impl ClosedSkin {
             .each_ref()
             .map(|r| r.iter().map(|&i| v[i as usize]).sum::<Vec3>() / r.len().max(1) as f32);
         v.extend(centres);
-        // Face each end fan away from the other end.
-        let mut tri = self.triangles.clone();
-        let n_side = tri.len() - self.ends[0].len() - self.ends[1].len();
-        let mut start = n_side;
-        for (e, end) in self.ends.iter().enumerate() {
-            let fan = &mut tri[start..start + end.len()];
-            let out = centres[e] - centres[1 - e];
-            let normal: Vec3 = fan
-                .iter()
-                .map(|t| {
-                    let [a, b, c] = t.map(|i| v[i as usize]);
-                    (b - a).cross(c - a)
-                })
-                .sum();
-            if normal.dot(out) < 0.0 {
-                fan.iter_mut().for_each(|t| t.swap(1, 2));
-            }
-            start += end.len();
-        }
-        let mesh = oriented_trimesh(&v, &tri)?;
+        let mesh = oriented_trimesh(&v, &self.triangles)?;
         Some(
             muscles
                 .par_iter()
