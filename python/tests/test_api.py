@@ -4,6 +4,8 @@ stepping, excitations, determinism and checkpoints."""
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 import pytest
@@ -215,14 +217,21 @@ def test_timers_count_the_rust_side_of_each_step_call(tissue: Simulation) -> Non
     assert tissue.timers == t
 
 
+def per_muscle_reach(
+    r: Mapping[str, Any], distance: str, sim: Simulation
+) -> tuple[Any, Any]:
+    """The two arrays of a per-muscle reach dict, checked for keys, shapes and dtypes."""
+    assert set(r) == {"vertices_over_1mm", distance}
+    count, dist = r["vertices_over_1mm"], r[distance]
+    n = len(sim.muscle_names)
+    assert count.shape == (n,) and count.dtype == np.int64
+    assert dist.shape == (n,) and dist.dtype == np.float32
+    return count, dist
+
+
 def test_muscles_in_bone_per_muscle(tissue: Simulation, rigid: Simulation) -> None:
     flex(tissue, 0.3)
-    r = tissue.muscles_in_bone()
-    assert set(r) == {"vertices_over_1mm", "deepest_m"}
-    count, deepest = r["vertices_over_1mm"], r["deepest_m"]
-    n = len(tissue.muscle_names)
-    assert count.shape == (n,) and count.dtype == np.int64
-    assert deepest.shape == (n,) and deepest.dtype == np.float32
+    count, deepest = per_muscle_reach(tissue.muscles_in_bone(), "deepest_m", tissue)
     assert (count >= 0).all() and (deepest >= 0.0).all() and np.isfinite(deepest).all()
     # A muscle with a vertex over 1 mm deep counts it, and one that counts none has none.
     assert ((deepest > 1e-3) == (count > 0)).all()
@@ -235,12 +244,7 @@ def test_muscles_in_bone_per_muscle(tissue: Simulation, rigid: Simulation) -> No
 
 def test_muscles_outside_skin_per_muscle(tissue: Simulation, rigid: Simulation) -> None:
     # At rest every muscle lies under the skin.
-    r = tissue.muscles_outside_skin()
-    assert set(r) == {"vertices_over_1mm", "farthest_m"}
-    count, farthest = r["vertices_over_1mm"], r["farthest_m"]
-    n = len(tissue.muscle_names)
-    assert count.shape == (n,) and count.dtype == np.int64
-    assert farthest.shape == (n,) and farthest.dtype == np.float32
+    count, farthest = per_muscle_reach(tissue.muscles_outside_skin(), "farthest_m", tissue)
     assert (count == 0).all() and (farthest < 1e-3).all()
     flex(tissue, 0.3)
     r = tissue.muscles_outside_skin()
