@@ -232,6 +232,14 @@ fn build(args: &BuildArgs) -> Result<()> {
         inv.fat_in_bone,
         inv.duplicate_vertices
     );
+    let sum = |f: fn(&myoslice::StructureReport) -> Option<usize>| {
+        report.structures.iter().filter_map(f).sum::<usize>()
+    };
+    println!(
+        "muscle vertices drawn out of bone: {}, left inside: {}",
+        sum(|s| s.vertices_drawn_out_of_bone),
+        sum(|s| s.vertices_left_in_bone)
+    );
     if let Some(p) = &args.vtu {
         myoslice::export::rest_vtu(&lattice).write(p)?;
     }

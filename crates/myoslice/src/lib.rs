@@ -33,7 +33,7 @@ pub use error::{Error, Result};
 pub use label_table::{Label, LabelTable, TissueKind};
 pub use label_volume::LabelVolume;
 pub use lattice::{BoneMesh, BuildOptions, FatLattice, Lattice, MuscleLattice, StructureStats};
-pub use report::BuildReport;
+pub use report::{BuildReport, StructureReport};
 pub use simulation::{Simulation, SimulationConfig, StepTimers};
 pub use slices::SliceReduction;
 

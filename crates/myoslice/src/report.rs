@@ -36,6 +36,13 @@ pub struct StructureReport {
     pub polygons: usize,
     /// How many of them were traced because a radial polygon fitted poorly.
     pub traced_polygons: usize,
+    /// Muscles: surface vertices drawn out of bone at build (where the polygons or the
+    /// tube between slices reached into one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vertices_drawn_out_of_bone: Option<usize>,
+    /// Muscles: surface vertices left inside a bone (no short way out along their ray).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vertices_left_in_bone: Option<usize>,
 }
 
 /// Totals of the lattice.
@@ -100,6 +107,10 @@ impl BuildReport {
                 min_iou: Some(st.min_iou),
                 polygons: st.polygons,
                 traced_polygons: st.traced_polygons,
+                vertices_drawn_out_of_bone: (st.kind == TissueKind::Muscle)
+                    .then_some(st.bone_clearance.drawn_in),
+                vertices_left_in_bone: (st.kind == TissueKind::Muscle)
+                    .then_some(st.bone_clearance.left_inside),
             });
         }
         let kind_of = lattice.table.kind_lut();
@@ -126,6 +137,8 @@ impl BuildReport {
             min_iou: None,
             polygons: lattice.fat.slices,
             traced_polygons: 0,
+            vertices_drawn_out_of_bone: None,
+            vertices_left_in_bone: None,
         });
         let (bv, mv, fv) = lattice.vertex_counts();
         Self {

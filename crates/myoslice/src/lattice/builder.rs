@@ -5,6 +5,7 @@ use std::collections::BTreeMap;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 
+use super::bone_clearance::{Clearance, clear_muscles_of_bone};
 use super::fat::{FatInputs, InnerContact, build_fat};
 use super::frame::SliceFrame;
 use super::tube::{RingInput, TubeMesh};
@@ -183,6 +184,7 @@ impl Lattice {
                 },
                 min_iou: acc.min_iou,
                 lattice_volume_m3: mesh.volume(),
+                bone_clearance: Clearance::default(),
             });
             match info.kind {
                 TissueKind::Bone => bones.push(BoneMesh {
@@ -205,6 +207,14 @@ impl Lattice {
                     });
                 }
                 _ => {}
+            }
+        }
+
+        let cleared = clear_muscles_of_bone(&mut muscles, &bones);
+        for (m, c) in muscles.iter().zip(cleared) {
+            if let Some(st) = stats.iter_mut().find(|s| s.label == m.label) {
+                st.bone_clearance = c;
+                st.lattice_volume_m3 = m.mesh.volume();
             }
         }
 

@@ -1,6 +1,7 @@
 //! The lattice body (paper, section 2): rigid bone surfaces, muscle ring lattices and the
 //! fat hexahedra, built from a labelled slice stack.
 
+mod bone_clearance;
 mod builder;
 pub mod checks;
 pub mod fat;
@@ -10,6 +11,7 @@ pub mod tube;
 
 use glam::Vec3;
 
+pub use bone_clearance::Clearance;
 pub use builder::BuildOptions;
 pub use checks::{InvariantReport, oriented_trimesh, strictly_inside, winding_number};
 pub use fat::{FatLattice, InnerContact, hex_volume, hex_volume_f32, hex_volume_points, quad_area};
@@ -68,6 +70,8 @@ pub struct StructureStats {
     pub min_iou: f64,
     /// Enclosed lattice volume (m³).
     pub lattice_volume_m3: f64,
+    /// Muscles: surface vertices drawn out of bone at build (zero for bones).
+    pub bone_clearance: Clearance,
 }
 
 /// The whole lattice body.

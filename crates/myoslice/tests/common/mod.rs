@@ -103,3 +103,40 @@ pub fn phantom_lattice() -> &'static Lattice {
         Lattice::build(&v, &t, &BuildOptions::default()).unwrap()
     })
 }
+
+/// Muscles with surface vertices more than 1 mm inside a bone of `lattice` (exact:
+/// pseudo-normals confirmed by the winding number): name, how many, the deepest (m).
+pub fn muscles_in_bone_at_build(lattice: &Lattice) -> Vec<(String, usize, f32)> {
+    use myoslice::lattice::{oriented_trimesh, strictly_inside};
+    use parry3d::query::PointQuery;
+    let bones: Vec<_> = lattice
+        .bones
+        .iter()
+        .map(|b| {
+            (
+                oriented_trimesh(&b.mesh.vertices, &b.mesh.triangles).unwrap(),
+                b,
+            )
+        })
+        .collect();
+    let mut out = Vec::new();
+    for m in &lattice.muscles {
+        let (mut n, mut deepest) = (0, 0.0f32);
+        for r in &m.mesh.rings {
+            for v in r.first..r.centre {
+                let p = m.mesh.vertices[v as usize];
+                for (t, b) in &bones {
+                    if strictly_inside(t, &b.mesh.vertices, &b.mesh.triangles, p) {
+                        let d = t.project_local_point(p, false).point.distance(p);
+                        n += usize::from(d > 1e-3);
+                        deepest = deepest.max(d);
+                    }
+                }
+            }
+        }
+        if n > 0 {
+            out.push((m.name.clone(), n, deepest));
+        }
+    }
+    out
+}
