@@ -1,13 +1,13 @@
 //! Muscle surfaces drawn clear of bone at build. No voxel is both muscle and bone, but
 //! the surfaces made from them can overlap: polygons are drawn over their regions with
 //! an IoU below 1, tube walls run straight between slices where the bone's shape
-//! changes, and end caps stand half a slice beyond the last ring. Each muscle vertex
-//! found inside a bone is drawn in along its ray, toward its ring's centre, to just
-//! outside the bone; an end cap reaching into a bone comes back toward its ring first.
+//! changes, and end caps stand beyond the last ring. Each muscle vertex found inside a
+//! bone is drawn in along its ray, toward its ring's centre, to just past the bone's
+//! surface; an end cap whose walls reach into a bone comes back toward its ring.
 //! Every ring stays in its plane, so the slab volumes are corrected exactly.
 
 use glam::Vec3;
-use parry3d::bounding_volume::Aabb;
+use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::query::{PointQuery, Ray, RayCast};
 use parry3d::shape::TriMesh;
 use rayon::prelude::*;
@@ -16,7 +16,7 @@ use super::checks::oriented_trimesh;
 use super::tube::{Slab, TubeMesh};
 use super::{BoneMesh, MuscleLattice};
 
-/// How far (m) outside the bone a drawn-in vertex ends up.
+/// How far (m) past the bone's surface, along its ray, a drawn-in vertex ends up.
 const CLEARANCE_M: f32 = 0.0005;
 
 /// Deepest (m) a muscle vertex is looked for inside a bone (the search stops there, which
@@ -29,9 +29,9 @@ const MAX_DETOUR: f32 = 4.0;
 /// ...plus this (m).
 const DETOUR_SLACK_M: f32 = 0.002;
 
-/// Least share of its distance from the ring centre a vertex keeps, and of its offset
-/// from its ring an end cap keeps: nothing collapses (a vertex that would need more
-/// stays where it is).
+/// Least share of its distance from the ring centre a vertex keeps (one that would need
+/// more stays where it is), and of its offset from its ring an end cap keeps (even if
+/// that leaves its walls in bone): nothing collapses.
 const MIN_SHARE: f32 = 0.1;
 
 /// What clearing one muscle did.
@@ -39,9 +39,10 @@ const MIN_SHARE: f32 = 0.1;
 pub struct Clearance {
     /// Surface vertices drawn out of bone.
     pub drawn_in: usize,
-    /// Surface vertices left inside a bone: their ray leaves it only near the ring's
-    /// centre or much further on than the bone's nearest surface, or the moved vertex
-    /// would make its ring cross itself.
+    /// Surface vertices inside a bone after clearing: their ray leaves it only near the
+    /// ring's centre, much further on than the bone's nearest surface or not at all, the
+    /// move would make their ring cross itself or turn over, or an end cap could not
+    /// come back far enough. Vertices deeper than [`MAX_DEPTH_M`] are not looked for.
     pub left_inside: usize,
 }
 
@@ -89,61 +90,74 @@ pub(crate) fn clear_muscles_of_bone(
 
 fn clear_tube(mesh: &mut TubeMesh, bones: &[BoneQuery]) -> Clearance {
     let n = mesh.ring_len();
-    if n < 3 {
+    if n < 3 || mesh.slabs.is_empty() {
         return Clearance::default();
     }
-    let in_bone = |p: Vec3| bones.iter().any(|b| b.inside(p));
+    let in_bone = |x: &[Vec3], v: usize| bones.iter().any(|b| b.inside(x[v]));
     let surface: Vec<usize> = mesh
         .rings
         .iter()
         .flat_map(|r| r.first as usize..r.first as usize + n)
         .collect();
-    let was_inside: Vec<usize> = surface
+    let mut was_inside: Vec<usize> = surface
         .iter()
         .copied()
-        .filter(|&v| in_bone(mesh.vertices[v]))
+        .filter(|&v| in_bone(&mesh.vertices, v))
         .collect();
-    if was_inside.is_empty() {
-        return Clearance::default();
-    }
+    was_inside.sort_unstable();
     let old = mesh.vertices.clone();
     let rings: Vec<usize> = (0..mesh.rings.len()).collect();
     let (caps, walls): (Vec<usize>, Vec<usize>) = rings.iter().partition(|&&r| mesh.rings[r].cap);
     draw_in(mesh, &walls, bones);
-    // A cap copies its end ring, moved half a slice on: it follows what the end ring did,
-    // and comes back toward it where that half slice reaches into bone.
+    // A cap is its end ring moved on along the tube: it follows what the end ring did,
+    // and comes back toward it where the walls between them reach into bone.
     for tube in mesh.tubes.clone() {
         let (first, last) = (tube.start as usize, tube.end as usize - 1);
-        if last > first + 1 {
-            pull_cap(mesh, first, first + 1, bones);
-            pull_cap(mesh, last, last - 1, bones);
-        }
+        pull_cap(mesh, &old, first, first + 1, bones);
+        pull_cap(mesh, &old, last, last - 1, bones);
     }
     draw_in(mesh, &caps, bones);
     let moved = |r: &super::tube::Ring| {
         (r.first..=r.centre).any(|v| mesh.vertices[v as usize] != old[v as usize])
     };
     let changed: Vec<bool> = mesh.rings.iter().map(moved).collect();
-    for s in 0..mesh.slabs.len() {
-        let slab = mesh.slabs[s];
-        if slab.rings.iter().any(|&r| changed[r as usize]) {
-            let before = fan_signed_volume(mesh, &old, &slab);
-            let after = fan_signed_volume(mesh, &mesh.vertices, &slab);
-            // Stored volumes are positive whatever the tube's orientation.
-            mesh.slabs[s].volume += before.signum() * (after - before);
+    if changed.iter().any(|&c| c) {
+        // Stored slab volumes are positive whatever way the rings run: the sign that
+        // relates them to the fans is the whole tube's.
+        let sign = mesh
+            .slabs
+            .iter()
+            .map(|s| fan_signed_volume(mesh, &old, s))
+            .sum::<f64>()
+            .signum();
+        for s in 0..mesh.slabs.len() {
+            let slab = mesh.slabs[s];
+            if slab.rings.iter().any(|&r| changed[r as usize]) {
+                let before = fan_signed_volume(mesh, &old, &slab);
+                let after = fan_signed_volume(mesh, &mesh.vertices, &slab);
+                mesh.slabs[s].volume += sign * (after - before);
+            }
         }
     }
-    let left_inside = was_inside
+    let still = was_inside
         .iter()
-        .filter(|&&v| in_bone(mesh.vertices[v]))
+        .filter(|&&v| in_bone(&mesh.vertices, v))
         .count();
+    // A vertex that was clear and has not moved still is.
+    let moved_in = surface
+        .iter()
+        .filter(|&&v| mesh.vertices[v] != old[v] && was_inside.binary_search(&v).is_err())
+        .filter(|&&v| in_bone(&mesh.vertices, v))
+        .count();
+    let left_inside = still + moved_in;
     Clearance {
-        drawn_in: was_inside.len() - left_inside,
+        drawn_in: was_inside.len() - still,
         left_inside,
     }
 }
 
-/// Draws each vertex of `rings` found inside a bone along its ray, see [`way_out`].
+/// Draws each vertex of `rings` found inside a bone along its ray, see [`way_out`] (out
+/// of each bone it is found in, in turn).
 fn draw_in(mesh: &mut TubeMesh, rings: &[usize], bones: &[BoneQuery]) {
     let n = mesh.ring_len();
     for &r in rings {
@@ -151,26 +165,31 @@ fn draw_in(mesh: &mut TubeMesh, rings: &[usize], bones: &[BoneQuery]) {
         let centre = mesh.vertices[ring.centre as usize];
         let ids = ring.first as usize..ring.first as usize + n;
         for j in 0..n {
-            let p = mesh.vertices[ring.first as usize + j];
-            let Some(bone) = bones.iter().find(|b| b.inside(p)) else {
-                continue;
-            };
-            if let Some(t) = way_out(bone, centre, p)
-                && stays_simple(&mesh.vertices[ids.clone()], j, t)
-            {
-                mesh.vertices[ring.first as usize + j] = t;
+            for _ in 0..bones.len() {
+                let p = mesh.vertices[ring.first as usize + j];
+                let Some(bone) = bones.iter().find(|b| b.inside(p)) else {
+                    break;
+                };
+                match way_out(bone, centre, p) {
+                    Some(t) if stays_simple(&mesh.vertices[ids.clone()], j, t) => {
+                        mesh.vertices[ring.first as usize + j] = t;
+                    }
+                    _ => break,
+                }
             }
         }
     }
 }
 
 /// Rebuilds cap ring `cap` (centre included) as a copy of its end ring `end` moved along
-/// the cap's offset, by as much of it as keeps the walls between them out of bone (at
-/// least [`MIN_SHARE`], so that the end slab keeps a volume).
-fn pull_cap(mesh: &mut TubeMesh, cap: usize, end: usize, bones: &[BoneQuery]) {
+/// the cap's offset, by as much of it as keeps the walls between them out of bone, but
+/// at least [`MIN_SHARE`] of it (the end slab keeps a volume, even if that is not clear).
+/// `old` holds the positions before any clearing; a cap neither pulled nor following a
+/// moved end ring is left as it was.
+fn pull_cap(mesh: &mut TubeMesh, old: &[Vec3], cap: usize, end: usize, bones: &[BoneQuery]) {
     let n = mesh.ring_len();
     let (c, e) = (mesh.rings[cap], mesh.rings[end]);
-    let off = mesh.vertices[c.centre as usize] - mesh.vertices[e.centre as usize];
+    let off = old[c.centre as usize] - old[e.centre as usize];
     let len = off.length();
     if len < 1e-9 {
         return;
@@ -179,7 +198,8 @@ fn pull_cap(mesh: &mut TubeMesh, cap: usize, end: usize, bones: &[BoneQuery]) {
     let mut share = 1.0f32;
     for j in 0..n {
         let from = mesh.vertices[e.first as usize + j];
-        for b in bones {
+        let wall = Aabb::new(from.min(from + off), from.max(from + off));
+        for b in bones.iter().filter(|b| b.aabb.intersects(&wall)) {
             // Along the wall nothing helps a vertex whose end is already in the bone.
             if b.inside(from) {
                 continue;
@@ -188,6 +208,10 @@ fn pull_cap(mesh: &mut TubeMesh, cap: usize, end: usize, bones: &[BoneQuery]) {
                 share = share.min(((t - CLEARANCE_M) / len).max(MIN_SHARE));
             }
         }
+    }
+    let end_ids = e.first as usize..=e.centre as usize;
+    if share == 1.0 && mesh.vertices[end_ids.clone()] == old[end_ids] {
+        return;
     }
     // The centre comes right after the ring's vertices (see `TubeMesh::add_tube`).
     for j in 0..=n {
@@ -216,8 +240,9 @@ fn way_out(bone: &BoneQuery, c: Vec3, p: Vec3) -> Option<Vec3> {
     .then_some(to)
 }
 
-/// Whether ring `ring` (planar, closed) stays free of crossings when its vertex `j`
-/// moves to `to`: the two edges at `j` must not cross any edge not adjacent to them.
+/// Whether ring `ring` (planar, closed) stays a simple polygon turning the same way when
+/// its vertex `j` moves to `to`: the two edges at `j` may not meet any edge not adjacent
+/// to them, and the signed area keeps its sign.
 fn stays_simple(ring: &[Vec3], j: usize, to: Vec3) -> bool {
     let n = ring.len();
     let normal = newell_normal(ring);
@@ -228,13 +253,24 @@ fn stays_simple(ring: &[Vec3], j: usize, to: Vec3) -> bool {
     let w = normal.cross(u);
     let flat = |p: Vec3| [p.dot(u), p.dot(w)];
     let at = |i: usize| if i == j { flat(to) } else { flat(ring[i]) };
+    // Twice the signed area; the normal was taken from the ring as it is, so it is
+    // positive before the move.
+    let area: f32 = (0..n)
+        .map(|i| {
+            let (a, b) = (at(i), at((i + 1) % n));
+            a[0] * b[1] - a[1] * b[0]
+        })
+        .sum();
+    if area <= 0.0 {
+        return false;
+    }
     let (prev, next) = ((j + n - 1) % n, (j + 1) % n);
     let moved = [(prev, j), (j, next)];
     (0..n).all(|e| {
         let e1 = (e + 1) % n;
         moved.iter().all(|&(a, b)| {
             // Edges sharing an end meet there by construction.
-            [a, b].contains(&e) || [a, b].contains(&e1) || !cross(at(a), at(b), at(e), at(e1))
+            [a, b].contains(&e) || [a, b].contains(&e1) || !meet(at(a), at(b), at(e), at(e1))
         })
     })
 }
@@ -253,8 +289,9 @@ fn newell_normal(ring: &[Vec3]) -> Vec3 {
     s.normalize_or_zero()
 }
 
-/// Whether segments `ab` and `cd` cross properly (touching counts as crossing).
-fn cross(a: [f32; 2], b: [f32; 2], c: [f32; 2], d: [f32; 2]) -> bool {
+/// Whether segments `ab` and `cd` meet: cross, touch, or (conservatively) lie on one
+/// line.
+fn meet(a: [f32; 2], b: [f32; 2], c: [f32; 2], d: [f32; 2]) -> bool {
     let orient = |p: [f32; 2], q: [f32; 2], r: [f32; 2]| {
         (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
     };
@@ -414,6 +451,33 @@ mod tests {
             "{zs:?}"
         );
         assert!((slab_sum(&m) - m.volume()).abs() < 1e-6 * m.volume());
+        assert!(m.slabs.iter().all(|s| s.volume > 0.0));
+    }
+
+    #[test]
+    fn a_mirrored_muscle_keeps_its_slab_volumes_right() {
+        let bones = [bone()];
+        // The same muscle as above with its rings running the other way round (as a
+        // mirrored voxel grid gives): the tube turns its triangles over.
+        let rings: Vec<RingInput> = (1..3)
+            .map(|i| {
+                let mut r = ring(i, [0.025, 0.0], 0.01 * i as f32, 0.02, 32, false);
+                r.points.reverse();
+                r.points_2d.reverse();
+                r
+            })
+            .collect();
+        let mut m = tube(&rings, 0.005);
+        let before = m.clone();
+        let done = clear_tube(&mut m, &bones);
+        assert!(done.drawn_in > 0 && done.left_inside == 0, "{done:?}");
+        assert!(m.volume() > 0.0 && m.volume() < before.volume());
+        assert!(
+            (slab_sum(&m) - m.volume()).abs() < 1e-6 * m.volume(),
+            "{} {}",
+            slab_sum(&m),
+            m.volume()
+        );
         assert!(m.slabs.iter().all(|s| s.volume > 0.0));
     }
 

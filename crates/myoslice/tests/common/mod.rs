@@ -104,10 +104,12 @@ pub fn phantom_lattice() -> &'static Lattice {
     })
 }
 
-/// Muscles with surface vertices more than 1 mm inside a bone of `lattice` (exact:
-/// pseudo-normals confirmed by the winding number): name, how many, the deepest (m).
+/// Muscles with surface vertices more than 1 mm inside a bone of `lattice` and no more
+/// than 3 cm from its surface: name, how many, the deepest (m). Exact where a bone's tubes
+/// overlap too: a bone of one tube is asked by pseudo-normals confirmed by the winding
+/// number, a bone of several by the winding number alone.
 pub fn muscles_in_bone_at_build(lattice: &Lattice) -> Vec<(String, usize, f32)> {
-    use myoslice::lattice::{oriented_trimesh, strictly_inside};
+    use myoslice::lattice::{oriented_trimesh, winding_number};
     use parry3d::query::PointQuery;
     let bones: Vec<_> = lattice
         .bones
@@ -126,8 +128,20 @@ pub fn muscles_in_bone_at_build(lattice: &Lattice) -> Vec<(String, usize, f32)> 
             for v in r.first..r.centre {
                 let p = m.mesh.vertices[v as usize];
                 for (t, b) in &bones {
-                    if strictly_inside(t, &b.mesh.vertices, &b.mesh.triangles, p) {
-                        let d = t.project_local_point(p, false).point.distance(p);
+                    if !t.local_aabb().contains_local_point(p) {
+                        continue;
+                    }
+                    let Some(proj) = t.project_local_point_with_max_dist(p, false, 0.03) else {
+                        continue;
+                    };
+                    let winding = || winding_number(&b.mesh.vertices, &b.mesh.triangles, p);
+                    let inside = if b.mesh.tubes.len() == 1 {
+                        proj.is_inside && winding().abs() > 0.5
+                    } else {
+                        winding().abs() > 0.5
+                    };
+                    if inside {
+                        let d = proj.point.distance(p);
                         n += usize::from(d > 1e-3);
                         deepest = deepest.max(d);
                     }
