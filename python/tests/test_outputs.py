@@ -140,32 +140,28 @@ def test_bad_scenarios_fail_with_a_message_naming_the_problem(text: str, needle:
 
 
 def test_an_interrupted_run_leaves_valid_frames(tmp_path: Path) -> None:
-    # The paper's experiment made ten times as long (about 20 s of writing frames here),
-    # so that the interrupt surely lands mid-run even if this process stalls a while:
-    # once, on a 1.5 s run, the run finished before the poll below saw its frames.
-    text = (ROOT / "assets" / "scenarios" / "knee_flexion.toml").read_text()
-    assert "duration_s = 1.5" in text and "frames = 30" in text
-    sc = tmp_path / "long.toml"
-    sc.write_text(text.replace("duration_s = 1.5", "duration_s = 15.0").replace("frames = 30", "frames = 300"))
-    out = tmp_path / "out"
+    # Ctrl-C as in a terminal: the run gets SIGINT's default action even when this test
+    # runs under a shell that ignores SIGINT (a background job of a script does, and
+    # its children inherit that; the run then finished and the test proved nothing).
     p = subprocess.Popen(
-        [str(cli()), "run", str(sc), "--out", str(out), "--quiet"],
+        [str(cli()), "run", str(ROOT / "assets" / "scenarios" / "knee_flexion.toml"), "--out", str(tmp_path), "--quiet"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     # Wait for a few frames, then interrupt.
     deadline = time.time() + 300
-    while time.time() < deadline and len(list(out.glob("frame_*.vtu"))) < 3:
+    while time.time() < deadline and len(list(tmp_path.glob("frame_*.vtu"))) < 3:
         time.sleep(0.2)
     p.send_signal(signal.SIGINT)
     code = p.wait(timeout=60)
     assert code != 0, "the run finished before it was interrupted: the test proves nothing"
-    assert not (out / "summary.json").exists(), "an interrupted run writes no summary"
-    pvd = ET.parse(out / "series.pvd").getroot()
+    assert not (tmp_path / "summary.json").exists(), "an interrupted run writes no summary"
+    pvd = ET.parse(tmp_path / "series.pvd").getroot()
     files = [d.get("file") for d in pvd.iter("DataSet")]
-    assert 3 <= len(files) < 301, f"{len(files)} frames listed of the scenario's 301"
+    assert 3 <= len(files) < 31, f"{len(files)} frames listed of the scenario's 31"
     for f in files:
-        assert np.isfinite(meshio.read(out / f).points).all()
+        assert np.isfinite(meshio.read(tmp_path / f).points).all()
     # A temporary *.partial file may remain from the frame being written; it is never listed.
-    rows = (out / "timeseries.csv").read_text().splitlines()
+    rows = (tmp_path / "timeseries.csv").read_text().splitlines()
     assert all(len(r.split(",")) == len(rows[0].split(",")) for r in rows)
