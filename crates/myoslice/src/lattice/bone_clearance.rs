@@ -15,6 +15,7 @@ use rayon::prelude::*;
 use super::checks::oriented_trimesh;
 use super::tube::{Slab, TubeMesh};
 use super::{BoneMesh, MuscleLattice};
+use crate::contour::signed_area;
 
 /// How far (m) past the bone's surface, along its ray, a drawn-in vertex ends up.
 const CLEARANCE_M: f32 = 0.0005;
@@ -108,7 +109,10 @@ fn clear_tube(mesh: &mut TubeMesh, bones: &[BoneQuery]) -> Clearance {
     let old = mesh.vertices.clone();
     let rings: Vec<usize> = (0..mesh.rings.len()).collect();
     let (caps, walls): (Vec<usize>, Vec<usize>) = rings.iter().partition(|&&r| mesh.rings[r].cap);
-    draw_in(mesh, &walls, bones);
+    // Only vertices found inside can need drawing in: a wall vertex moves only by itself.
+    draw_in(mesh, &walls, bones, |v| {
+        was_inside.binary_search(&v).is_ok()
+    });
     // A cap is its end ring moved on along the tube: it follows what the end ring did,
     // and comes back toward it where the walls between them reach into bone.
     for tube in mesh.tubes.clone() {
@@ -116,7 +120,8 @@ fn clear_tube(mesh: &mut TubeMesh, bones: &[BoneQuery]) -> Clearance {
         pull_cap(mesh, &old, first, first + 1, bones);
         pull_cap(mesh, &old, last, last - 1, bones);
     }
-    draw_in(mesh, &caps, bones);
+    // Pulled caps may have moved into bone: all their vertices are looked at again.
+    draw_in(mesh, &caps, bones, |_| true);
     let moved = |r: &super::tube::Ring| {
         (r.first..=r.centre).any(|v| mesh.vertices[v as usize] != old[v as usize])
     };
@@ -156,15 +161,20 @@ fn clear_tube(mesh: &mut TubeMesh, bones: &[BoneQuery]) -> Clearance {
     }
 }
 
-/// Draws each vertex of `rings` found inside a bone along its ray, see [`way_out`] (out
-/// of each bone it is found in, in turn).
-fn draw_in(mesh: &mut TubeMesh, rings: &[usize], bones: &[BoneQuery]) {
+/// Draws each vertex of `rings` that `candidate` admits and is found inside a bone along
+/// its ray, see [`way_out`] (out of each bone it is found in, in turn).
+fn draw_in(
+    mesh: &mut TubeMesh,
+    rings: &[usize],
+    bones: &[BoneQuery],
+    candidate: impl Fn(usize) -> bool,
+) {
     let n = mesh.ring_len();
     for &r in rings {
         let ring = mesh.rings[r];
         let centre = mesh.vertices[ring.centre as usize];
         let ids = ring.first as usize..ring.first as usize + n;
-        for j in 0..n {
+        for j in (0..n).filter(|&j| candidate(ring.first as usize + j)) {
             for _ in 0..bones.len() {
                 let p = mesh.vertices[ring.first as usize + j];
                 let Some(bone) = bones.iter().find(|b| b.inside(p)) else {
@@ -253,15 +263,10 @@ fn stays_simple(ring: &[Vec3], j: usize, to: Vec3) -> bool {
     let w = normal.cross(u);
     let flat = |p: Vec3| [p.dot(u), p.dot(w)];
     let at = |i: usize| if i == j { flat(to) } else { flat(ring[i]) };
-    // Twice the signed area; the normal was taken from the ring as it is, so it is
-    // positive before the move.
-    let area: f32 = (0..n)
-        .map(|i| {
-            let (a, b) = (at(i), at((i + 1) % n));
-            a[0] * b[1] - a[1] * b[0]
-        })
-        .sum();
-    if area <= 0.0 {
+    // The normal was taken from the ring as it is, so its area is positive before the
+    // move.
+    let moved_ring: Vec<[f64; 2]> = (0..n).map(|i| at(i).map(f64::from)).collect();
+    if signed_area(&moved_ring) <= 0.0 {
         return false;
     }
     let (prev, next) = ((j + n - 1) % n, (j + 1) % n);
@@ -380,18 +385,38 @@ mod tests {
         p.x.abs() < 0.01 && p.y.abs() < 0.01 && p.z > z[0] && p.z < z[1]
     }
 
-    fn slab_sum(m: &TubeMesh) -> f64 {
-        m.slabs.iter().map(|s| s.volume).sum()
+    /// The slabs add up to the volume the surface encloses, every one positive.
+    fn assert_slabs_add_up(m: &TubeMesh) {
+        let sum: f64 = m.slabs.iter().map(|s| s.volume).sum();
+        assert!(
+            (sum - m.volume()).abs() < 1e-6 * m.volume(),
+            "{sum} {}",
+            m.volume()
+        );
+        assert!(m.slabs.iter().all(|s| s.volume > 0.0));
+    }
+
+    /// A round muscle 2 cm in radius whose side reaches 5 mm into the bone; `mirrored`,
+    /// its rings run the other way round (as a mirrored voxel grid gives), so the tube
+    /// turns its triangles over.
+    fn muscle_beside_the_bone(mirrored: bool) -> TubeMesh {
+        let rings: Vec<RingInput> = (1..3)
+            .map(|i| {
+                let mut r = ring(i, [0.025, 0.0], 0.01 * i as f32, 0.02, 32, false);
+                if mirrored {
+                    r.points.reverse();
+                    r.points_2d.reverse();
+                }
+                r
+            })
+            .collect();
+        tube(&rings, 0.005)
     }
 
     #[test]
     fn a_muscle_beside_a_bone_is_drawn_out_of_it_along_its_rays() {
         let bones = [bone()];
-        // A round muscle 2 cm in radius whose side reaches 5 mm into the bone.
-        let rings: Vec<RingInput> = (1..3)
-            .map(|i| ring(i, [0.025, 0.0], 0.01 * i as f32, 0.02, 32, false))
-            .collect();
-        let mut m = tube(&rings, 0.005);
+        let mut m = muscle_beside_the_bone(false);
         let before = m.clone();
         let inside = |m: &TubeMesh| {
             m.vertices
@@ -414,13 +439,8 @@ mod tests {
             }
         }
         // The slabs still add up to the volume the surface encloses, which shrank.
-        assert!(
-            (slab_sum(&m) - m.volume()).abs() < 1e-6 * m.volume(),
-            "{} {}",
-            slab_sum(&m),
-            m.volume()
-        );
-        assert!(m.volume() < before.volume() && m.slabs.iter().all(|s| s.volume > 0.0));
+        assert_slabs_add_up(&m);
+        assert!(m.volume() < before.volume());
     }
 
     #[test]
@@ -450,35 +470,18 @@ mod tests {
             zs.iter().all(|z| (z - 0.035 - CLEARANCE_M).abs() < 1e-6),
             "{zs:?}"
         );
-        assert!((slab_sum(&m) - m.volume()).abs() < 1e-6 * m.volume());
-        assert!(m.slabs.iter().all(|s| s.volume > 0.0));
+        assert_slabs_add_up(&m);
     }
 
     #[test]
     fn a_mirrored_muscle_keeps_its_slab_volumes_right() {
         let bones = [bone()];
-        // The same muscle as above with its rings running the other way round (as a
-        // mirrored voxel grid gives): the tube turns its triangles over.
-        let rings: Vec<RingInput> = (1..3)
-            .map(|i| {
-                let mut r = ring(i, [0.025, 0.0], 0.01 * i as f32, 0.02, 32, false);
-                r.points.reverse();
-                r.points_2d.reverse();
-                r
-            })
-            .collect();
-        let mut m = tube(&rings, 0.005);
+        let mut m = muscle_beside_the_bone(true);
         let before = m.clone();
         let done = clear_tube(&mut m, &bones);
         assert!(done.drawn_in > 0 && done.left_inside == 0, "{done:?}");
         assert!(m.volume() > 0.0 && m.volume() < before.volume());
-        assert!(
-            (slab_sum(&m) - m.volume()).abs() < 1e-6 * m.volume(),
-            "{} {}",
-            slab_sum(&m),
-            m.volume()
-        );
-        assert!(m.slabs.iter().all(|s| s.volume > 0.0));
+        assert_slabs_add_up(&m);
     }
 
     #[test]
