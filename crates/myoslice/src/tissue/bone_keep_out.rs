@@ -218,21 +218,28 @@ impl BoneKeepOut {
 
     /// Finds the rings a bone reaches into, shifts them out (a neighbour as far as the
     /// largest of [`SPREAD`]'s shares of the rings near it, so the surface bends rather
-    /// than steps) and moves their vertices in `current` with them. Returns whether
-    /// anything moved.
+    /// than steps) and moves their vertices in `current` with them. Returns how many of
+    /// the vertices it moved out were more than 1 mm deep, None when nothing moved.
     ///
     /// A ring moves across its muscle only (`axis` gives each ring's direction): moved
     /// along, it would slide into its neighbours and crease the surface.
+    ///
+    /// `again` says the last call was this update's previous round: then only the
+    /// vertices that call moved are looked at (the others would be found as they were).
     pub(crate) fn push_out(
         &mut self,
         current: &mut [Vec3],
         ring_of: &[u32],
         axis: impl Fn(usize) -> Vec3,
         bones: &Bones,
-    ) -> bool {
+        again: bool,
+    ) -> Option<usize> {
         self.need.iter_mut().for_each(|n| *n = Vec3::ZERO);
-        let mut any = false;
+        let mut deep: Option<usize> = None;
         for (&(v, b), w) in self.pairs.iter().zip(&mut self.watch) {
+            if again && self.spread[ring_of[v as usize] as usize] == Vec3::ZERO {
+                continue;
+            }
             let Some(d) = bones.depth(b as usize, current[v as usize], w) else {
                 continue;
             };
@@ -255,11 +262,9 @@ impl BoneKeepOut {
             if push.length_squared() > need.length_squared() {
                 *need = push;
             }
-            any = true;
+            deep = Some(deep.unwrap_or(0) + usize::from(d.length_squared() > 1e-6));
         }
-        if !any {
-            return false;
-        }
+        deep?;
         let rings = self.need.len();
         for r in 0..rings {
             let mut total = self.need[r];
@@ -279,7 +284,7 @@ impl BoneKeepOut {
         for (p, &r) in current.iter_mut().zip(ring_of) {
             *p += self.spread[r as usize];
         }
-        true
+        deep
     }
 }
 

@@ -6,6 +6,7 @@
 use glam::{Quat, Vec3};
 use parry3d::query::PointQueryWithLocation;
 use parry3d::shape::TriMesh;
+use rayon::prelude::*;
 
 use crate::body::BodyId;
 
@@ -198,10 +199,18 @@ impl BoneMesh {
     /// steps, the tree (`tree`, this bone's parry mesh) decides before anything moves.
     pub(crate) fn walk_checked(&self, start: u32, p: Vec3, tree: &TriMesh) -> Walk {
         let w = self.walk(start, p);
-        if w.inside || !w.settled {
-            self.walk_from_tree(tree, p)
-        } else {
-            w
+        if w.settled && !w.inside {
+            return w;
+        }
+        // The walk's point lies on the surface, so the nearest is no further: the tree
+        // searches only that far (most of it is pruned at once; an unbounded search cost
+        // about three times as much).
+        match tree.project_local_point_and_get_location_with_max_dist(p, false, w.point.distance(p))
+        {
+            Some((_, (tri, _))) => self.walk(tri, p),
+            // Nothing nearer: the walk's point is the nearest, and its pseudo-normal
+            // tells inside from outside.
+            None => w,
         }
     }
 }
@@ -277,26 +286,34 @@ impl BoneSlide {
         free: &[bool],
         meshes: &[BoneMesh],
         surfaces: &[(BodyId, TriMesh)],
-        pose: impl Fn(BodyId) -> (Quat, Vec3),
+        pose: impl Fn(BodyId) -> (Quat, Vec3) + Sync,
     ) {
-        for (k, &(v, b, d0)) in self.vertices.iter().enumerate() {
-            if !free[v as usize] {
-                continue; // moves rigidly with its bone already
-            }
-            let mesh = &meshes[b as usize];
-            let (q, t) = pose(mesh.body);
-            let p_rest = q.inverse() * (x[v as usize] - t);
-            let w = mesh.walk_checked(self.nearest[k], p_rest, &surfaces[b as usize].1);
-            self.nearest[k] = w.triangle;
-            let out = if w.inside {
-                (w.point - p_rest).normalize_or_zero()
-            } else {
-                (p_rest - w.point).normalize_or_zero()
-            };
-            // Slide on the bone: pulled onto the surface (at its rest distance), softly.
-            let target = q * (w.point + out * d0) + t;
-            let cur = x[v as usize];
-            x[v as usize] = cur + (target - cur) * if w.inside { 1.0 } else { 0.7 };
+        // Each vertex is pulled by itself: in parallel, written back in order.
+        let xs = &*x;
+        let moved: Vec<(u32, Vec3)> = self
+            .vertices
+            .par_iter()
+            .zip(self.nearest.par_iter_mut())
+            .filter(|((v, ..), _)| free[*v as usize]) // the rest moves rigidly with its bone
+            .map(|(&(v, b, d0), nearest)| {
+                let mesh = &meshes[b as usize];
+                let (q, t) = pose(mesh.body);
+                let p_rest = q.inverse() * (xs[v as usize] - t);
+                let w = mesh.walk_checked(*nearest, p_rest, &surfaces[b as usize].1);
+                *nearest = w.triangle;
+                let out = if w.inside {
+                    (w.point - p_rest).normalize_or_zero()
+                } else {
+                    (p_rest - w.point).normalize_or_zero()
+                };
+                // Slide on the bone: pulled onto the surface (at its rest distance), softly.
+                let target = q * (w.point + out * d0) + t;
+                let cur = xs[v as usize];
+                (v, cur + (target - cur) * if w.inside { 1.0 } else { 0.7 })
+            })
+            .collect();
+        for (v, p) in moved {
+            x[v as usize] = p;
         }
     }
 }

@@ -11,7 +11,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::fat_solver::FatSolver;
-use super::intersect::{Aabb, TriangleGrid, crossing_pairs_of_few};
+use super::intersect::{Aabb, TriangleGrid, crossing_pairs_near, crossing_pairs_of_few};
 use crate::lattice::hex_volume_f32 as hex_volume;
 
 /// Queried triangles up to which a round checks them without a grid.
@@ -113,7 +113,9 @@ impl Guard {
                 let live = &self.live;
                 let queried = |i: u32| live[i as usize];
                 // A grid pays for itself only for many queries (the first round).
-                let pairs = if self.query.len() > FEW {
+                let pairs = if round > 0 && self.query.len() > FEW {
+                    crossing_pairs_near(&fat.x, triangles, &self.boxes, &self.query, queried)
+                } else if self.query.len() > FEW {
                     TriangleGrid::new(&self.boxes, triangles, &fat.x).map_or_else(Vec::new, |g| {
                         g.crossing_pairs(&fat.x, triangles, &self.boxes, &self.query, queried)
                     })

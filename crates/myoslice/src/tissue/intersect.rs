@@ -181,24 +181,29 @@ impl TriangleGrid {
             self.for_cells(&boxes[a as usize], |k| touched[k] = true);
         }
         let cells: Vec<usize> = (0..touched.len()).filter(|&k| touched[k]).collect();
+        // The cell of each box's low corner: that of a pair's overlap is their
+        // componentwise max (`cell_of` is monotone), with no float work per pair.
+        let low: Vec<UVec3> = boxes.iter().map(|b| self.cell_of(b.lo)).collect();
+        let (nx, nxy) = (
+            self.dims.x as usize,
+            self.dims.x as usize * self.dims.y as usize,
+        );
         // Cells in parallel; the sort below makes the order independent of the split.
         let mut pairs: Vec<(u32, u32)> = cells
             .par_chunks(256)
             .flat_map_iter(|chunk| {
                 let mut found = Vec::new();
                 for &k in chunk {
+                    let here = UVec3::new((k % nx) as u32, (k % nxy / nx) as u32, (k / nxy) as u32);
                     let c = &self.items[self.start[k] as usize..self.start[k + 1] as usize];
                     for (ia, &a) in c.iter().enumerate() {
+                        let (ba, la, qa) = (boxes[a as usize], low[a as usize], queried(a));
                         for &b in &c[ia + 1..] {
-                            if !(queried(a) || queried(b)) {
-                                continue;
-                            }
-                            let (ba, bb) = (&boxes[a as usize], &boxes[b as usize]);
-                            if !ba.overlaps(bb) {
+                            if !(qa || queried(b)) || !ba.overlaps(&boxes[b as usize]) {
                                 continue;
                             }
                             // Each pair once: in the cell holding the overlap's low corner.
-                            if self.key(self.cell_of(ba.lo.max(bb.lo))) != k {
+                            if la.max(low[b as usize]) != here {
                                 continue;
                             }
                             if let Some(p) = crossing(vertices, triangles, a, b) {
@@ -224,16 +229,7 @@ pub fn crossing_pairs_of_few(
     query: &[u32],
     queried: impl Fn(u32) -> bool,
 ) -> Vec<(u32, u32)> {
-    let Some(all) = query
-        .iter()
-        .map(|&a| boxes[a as usize])
-        .reduce(|u, b| u.union(&b))
-    else {
-        return Vec::new();
-    };
-    let near: Vec<u32> = (0..boxes.len() as u32)
-        .filter(|&b| boxes[b as usize].overlaps(&all))
-        .collect();
+    let near = near_query(boxes, query);
     let mut pairs = Vec::new();
     for &a in query {
         for &b in &near {
@@ -248,6 +244,51 @@ pub fn crossing_pairs_of_few(
     }
     pairs.sort_unstable();
     pairs
+}
+
+/// The pairs, as [`TriangleGrid::crossing_pairs`], from a grid over only the triangles
+/// whose boxes meet the box around the queried ones: after a local change that grid is
+/// a small part of the whole.
+pub fn crossing_pairs_near(
+    vertices: &[Vec3],
+    triangles: &[[u32; 3]],
+    boxes: &[Aabb],
+    query: &[u32],
+    queried: impl Fn(u32) -> bool + Sync,
+) -> Vec<(u32, u32)> {
+    // In index order, so pairs keep their order when mapped back.
+    let near = near_query(boxes, query);
+    let sub_boxes: Vec<Aabb> = near.iter().map(|&i| boxes[i as usize]).collect();
+    let sub_triangles: Vec<[u32; 3]> = near.iter().map(|&i| triangles[i as usize]).collect();
+    // Every queried triangle is near (its box is inside the union).
+    let local: Vec<u32> = query
+        .iter()
+        .filter_map(|a| near.binary_search(a).ok().map(|l| l as u32))
+        .collect();
+    let Some(grid) = TriangleGrid::new(&sub_boxes, &sub_triangles, vertices) else {
+        return Vec::new();
+    };
+    grid.crossing_pairs(vertices, &sub_triangles, &sub_boxes, &local, |l| {
+        queried(near[l as usize])
+    })
+    .into_iter()
+    .map(|(a, b)| (near[a as usize], near[b as usize]))
+    .collect()
+}
+
+/// The triangles, in index order, whose boxes meet the box around the queried ones
+/// (none without a query).
+fn near_query(boxes: &[Aabb], query: &[u32]) -> Vec<u32> {
+    let Some(all) = query
+        .iter()
+        .map(|&a| boxes[a as usize])
+        .reduce(|u, b| u.union(&b))
+    else {
+        return Vec::new();
+    };
+    (0..boxes.len() as u32)
+        .filter(|&b| boxes[b as usize].overlaps(&all))
+        .collect()
 }
 
 /// `(min, max)` if triangles `a` and `b` share no vertex and cross.
@@ -365,15 +406,25 @@ mod tests {
     }
 
     #[test]
-    fn the_grid_and_the_few_triangle_search_find_exactly_the_crossing_pairs() {
+    fn the_grid_and_the_local_searches_find_exactly_the_crossing_pairs() {
         let (v, t) = crumpled();
         let boxes: Vec<Aabb> = t.iter().map(|tri| Aabb::of(&v, tri)).collect();
         let grid = TriangleGrid::new(&boxes, &t, &v).unwrap_or_else(|| panic!("a grid"));
-        for stride in [1, 3, 7, 50] {
-            let query: Vec<u32> = (0..t.len() as u32)
-                .filter(|i| i.is_multiple_of(stride))
-                .collect();
-            let queried = |i: u32| i.is_multiple_of(stride);
+        // Spread over the sheet, and a patch across the fold (rows 3–5, columns 4–8).
+        type Query = Box<dyn Fn(u32) -> bool + Sync>;
+        let mut cases: Vec<(String, Query)> = [1, 3, 7, 50]
+            .map(|stride| {
+                let q: Query = Box::new(move |i| i % stride == 0);
+                (format!("every {stride}th triangle"), q)
+            })
+            .into_iter()
+            .collect();
+        cases.push((
+            "a patch".into(),
+            Box::new(|i| (4..9).contains(&(i / 2 % 12)) && (3..6).contains(&(i / 24))),
+        ));
+        for (name, queried) in &cases {
+            let query: Vec<u32> = (0..t.len() as u32).filter(|&i| queried(i)).collect();
             // Every pair, by brute force.
             let mut want = Vec::new();
             for a in 0..t.len() as u32 {
@@ -387,10 +438,15 @@ mod tests {
             }
             let by_grid = grid.crossing_pairs(&v, &t, &boxes, &query, queried);
             let by_few = crossing_pairs_of_few(&v, &t, &boxes, &query, queried);
-            assert!(!want.is_empty(), "the sheet crosses itself");
-            assert_eq!(by_grid, want, "grid, every {stride}th triangle queried");
-            assert_eq!(by_few, want, "few, every {stride}th triangle queried");
+            let by_near = crossing_pairs_near(&v, &t, &boxes, &query, queried);
+            assert!(!want.is_empty(), "the sheet crosses itself at {name}");
+            assert_eq!(by_grid, want, "grid, {name} queried");
+            assert_eq!(by_few, want, "few, {name} queried");
+            assert_eq!(by_near, want, "near, {name} queried");
         }
+        // The patch's grid is a part of the sheet's.
+        let patch: Vec<u32> = (0..t.len() as u32).filter(|&i| cases[4].1(i)).collect();
+        assert!(near_query(&boxes, &patch).len() < t.len());
     }
 
     #[test]

@@ -225,17 +225,25 @@ impl MuscleShape {
             if pass == 0
                 && let Some(b) = bones
             {
-                for _ in 0..PUSH_ROUNDS {
+                let mut last = usize::MAX;
+                for round in 0..PUSH_ROUNDS {
                     let axis = |r: usize| rings[r].2;
-                    if !self
-                        .keep
-                        .push_out(&mut self.current, &self.ring_of, axis, b)
-                    {
+                    let Some(deep) =
+                        self.keep
+                            .push_out(&mut self.current, &self.ring_of, axis, b, round > 0)
+                    else {
                         break;
-                    }
+                    };
                     for (ring, s) in rings.iter_mut().zip(&self.keep.spread) {
                         ring.0 += *s;
                     }
+                    // A round that finds no fewer vertices over 1 mm deep than the last is
+                    // the last: rings pushing each other back in (as one wrapped round a
+                    // bone does) would use every round for nothing.
+                    if deep >= last {
+                        break;
+                    }
+                    last = deep;
                 }
             }
             // What the piecewise map still gains or loses, the cross-sections give back:
