@@ -20,12 +20,22 @@ const FEW: usize = 64;
 /// Most rounds (each settles at least one more vertex).
 const MAX_ROUNDS: usize = 64;
 
+/// Marks vertex `i` bad, listing it the first time.
+fn mark(bad: &mut [bool], list: &mut Vec<usize>, i: usize) {
+    if !bad[i] {
+        bad[i] = true;
+        list.push(i);
+    }
+}
+
 /// Reused buffers of the guard.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Guard {
     relaxed: Vec<Vec3>,
     share: Vec<f32>,
     bad: Vec<bool>,
+    /// The vertices marked in `bad` (each once).
+    bad_list: Vec<usize>,
     moved_now: Vec<bool>,
     moved_list: Vec<usize>,
     bad_el: Vec<usize>,
@@ -56,6 +66,7 @@ impl Guard {
         self.share.clear();
         self.share.resize(n, 1.0);
         self.moved_list.clear();
+        self.bad_list.clear();
         let too_small = |x: &[Vec3], e: usize, fat: &FatSolver| {
             let h = &fat.hexes[e];
             let v = hex_volume(x, h);
@@ -93,7 +104,7 @@ impl Guard {
             }
             for &e in &self.bad_el {
                 for &i in &fat.hexes[e] {
-                    self.bad[i as usize] = true;
+                    mark(&mut self.bad, &mut self.bad_list, i as usize);
                 }
             }
             if surface {
@@ -107,9 +118,16 @@ impl Guard {
                 self.query.clear();
                 self.query
                     .extend((0..triangles.len() as u32).filter(|&i| self.live[i as usize]));
-                self.boxes.clear();
-                self.boxes
-                    .extend(triangles.iter().map(|t| Aabb::of(&fat.x, t)));
+                // Only the queried triangles' boxes can have changed since the last round.
+                if round == 0 {
+                    self.boxes.clear();
+                    self.boxes
+                        .extend(triangles.iter().map(|t| Aabb::of(&fat.x, t)));
+                } else {
+                    for &i in &self.query {
+                        self.boxes[i as usize] = Aabb::of(&fat.x, &triangles[i as usize]);
+                    }
+                }
                 let live = &self.live;
                 let queried = |i: u32| live[i as usize];
                 // A grid pays for itself only for many queries (the first round).
@@ -123,8 +141,8 @@ impl Guard {
                     crossing_pairs_of_few(&fat.x, triangles, &self.boxes, &self.query, queried)
                 };
                 for (a, b) in pairs {
-                    for i in triangles[a as usize].iter().chain(&triangles[b as usize]) {
-                        self.bad[*i as usize] = true;
+                    for &i in triangles[a as usize].iter().chain(&triangles[b as usize]) {
+                        mark(&mut self.bad, &mut self.bad_list, i as usize);
                     }
                 }
             }
@@ -133,13 +151,16 @@ impl Guard {
                 self.moved_now[v] = false;
             }
             self.moved_list.clear();
-            for (i, b) in self.bad.iter_mut().enumerate() {
-                if std::mem::take(b) && self.share[i] > 0.0 {
+            self.bad_list.sort_unstable();
+            for &i in &self.bad_list {
+                self.bad[i] = false;
+                if self.share[i] > 0.0 {
                     self.moved_now[i] = true;
                     self.moved_list.push(i);
                     self.share[i] = 0.0;
                 }
             }
+            self.bad_list.clear();
             if self.moved_list.is_empty() {
                 break;
             }
