@@ -11,6 +11,7 @@ use parry3d::shape::TriMesh;
 
 use super::bone_slide::BoneMesh;
 use crate::body::BodyId;
+use crate::lattice::winding_number;
 use crate::muscle::BodyFrames;
 
 /// Muscle vertices closer than this (m) to a bone at rest are watched against it...
@@ -298,7 +299,10 @@ pub struct BoneOverlap {
 }
 
 /// Measures `vertices` against every bone (exact: a tree query per vertex near a bone).
-pub(crate) fn overlap(vertices: &[Vec3], bones: &Bones) -> BoneOverlap {
+/// `crossed[b]` says bone `b`'s surface crosses itself (tubes of one bone overlapping,
+/// or a tube folding): there the pseudo-normal can call a point outside inside, so the
+/// winding number confirms it.
+pub(crate) fn overlap(vertices: &[Vec3], bones: &Bones, crossed: &[bool]) -> BoneOverlap {
     let mut o = BoneOverlap::default();
     for (b, (body, mesh)) in bones.surfaces.iter().enumerate() {
         let (q, t) = bones.pose(*body);
@@ -309,11 +313,17 @@ pub(crate) fn overlap(vertices: &[Vec3], bones: &Bones) -> BoneOverlap {
                 continue;
             }
             let w = bones.meshes[b].walk_from_tree(mesh, p_rest);
-            if w.inside {
-                let d = w.point.distance(p_rest);
-                o.deepest_m = o.deepest_m.max(d);
-                o.vertices_over_1mm += usize::from(d > 1e-3);
+            let d = w.point.distance(p_rest);
+            // Only what would change the result is confirmed (a winding number visits
+            // every triangle).
+            if !w.inside || (d <= 1e-3 && d <= o.deepest_m) {
+                continue;
             }
+            if crossed[b] && winding_number(mesh.vertices(), mesh.indices(), p_rest).abs() < 0.5 {
+                continue;
+            }
+            o.deepest_m = o.deepest_m.max(d);
+            o.vertices_over_1mm += usize::from(d > 1e-3);
         }
     }
     o

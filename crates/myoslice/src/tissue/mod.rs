@@ -15,7 +15,7 @@ pub mod muscle_shape;
 pub mod polar;
 mod skin_breach;
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use glam::{Quat, Vec3};
 use parry3d::shape::TriMesh;
@@ -134,6 +134,9 @@ struct TissueStatic {
     outer_faces: Vec<(u32, [u32; 4], f64)>,
     /// The skin closed at both ends (for [`Tissue::muscles_outside_skin`]).
     skin: ClosedSkin,
+    /// Whether each bone's surface crosses itself (see [`bone_keep_out::overlap`]),
+    /// found when first needed.
+    bones_crossed: OnceLock<Vec<bool>>,
 }
 
 /// Buffers an update fills anew each time, kept to avoid allocating them. A copy of the
@@ -272,6 +275,7 @@ impl Tissue {
             bones: Arc::clone(&bones),
             outer_faces,
             skin: ClosedSkin::new(fat),
+            bones_crossed: OnceLock::new(),
         };
         let tissue = Self {
             config,
@@ -308,8 +312,8 @@ impl Tissue {
     }
 
     /// How far each muscle's surface reaches into bone with the bodies at `frames`, in
-    /// muscle order (exact, one tree query per muscle vertex near a bone: for checks,
-    /// not for every update).
+    /// muscle order (exact, one tree query per muscle vertex near a bone, and a winding
+    /// number where a bone's surface crosses itself: for checks, not for every update).
     pub fn muscles_in_bone(&self, frames: &BodyFrames) -> Vec<BoneOverlap> {
         let bones = Bones {
             meshes: &self.fixed.bone_meshes,
@@ -317,9 +321,16 @@ impl Tissue {
             frames,
             fade: 1.0,
         };
+        let crossed = self.fixed.bones_crossed.get_or_init(|| {
+            self.fixed
+                .bones
+                .par_iter()
+                .map(|(_, m)| intersect::self_intersections(m.vertices(), m.indices()) > 0)
+                .collect()
+        });
         self.muscles
             .par_iter()
-            .map(|m| bone_keep_out::overlap(&m.current, &bones))
+            .map(|m| bone_keep_out::overlap(&m.current, &bones, crossed))
             .collect()
     }
 
