@@ -17,6 +17,16 @@ _StrPath: TypeAlias = str | os.PathLike[str]
 
 __version__: str
 
+class _TissuePhases(TypedDict):
+    """Seconds of the tissue updates, phase by phase, in update order."""
+
+    muscle_shapes: float
+    knee_fold: float
+    first_guess: float
+    shape_matching: float
+    bone_sliding: float
+    guard: float
+
 class _StepTimers(TypedDict):
     """What :attr:`Simulation.timers` returns (seconds of wall-clock time, on the Rust side)."""
 
@@ -28,6 +38,7 @@ class _StepTimers(TypedDict):
     tissue_wall_s: float
     muscles_wall_s: float
     realtime_factor: float | None
+    tissue_phases_s: _TissuePhases
 
 class _MusclesInBone(TypedDict):
     """What :meth:`Simulation.muscles_in_bone` returns, one entry per muscle."""
@@ -107,8 +118,10 @@ class Simulation:
     def timers(self) -> _StepTimers:
         """Wall-clock time spent in :meth:`step` on the Rust side since the build or
         :meth:`reset_timers`: ``calls``, ``steps``, ``tissue_updates`` (counts),
-        ``simulated_s``, ``wall_s``, ``tissue_wall_s``, ``muscles_wall_s`` (seconds) and
-        ``realtime_factor`` (None before any step)."""
+        ``simulated_s``, ``wall_s``, ``tissue_wall_s``, ``muscles_wall_s`` (seconds),
+        ``realtime_factor`` (None before any step) and ``tissue_phases_s`` (the tissue's
+        seconds by phase: ``muscle_shapes``, ``knee_fold``, ``first_guess``,
+        ``shape_matching``, ``bone_sliding``, ``guard``)."""
 
     def reset_timers(self) -> None:
         """Starts the step timers from zero."""

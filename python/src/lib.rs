@@ -233,6 +233,11 @@ impl PySimulation {
         d.set_item("tissue_wall_s", t.tissue_wall_s)?;
         d.set_item("muscles_wall_s", t.muscles_wall_s())?;
         d.set_item("realtime_factor", t.realtime_factor())?;
+        let phases = PyDict::new(py);
+        for (name, s) in t.tissue_phases.named() {
+            phases.set_item(name, s)?;
+        }
+        d.set_item("tissue_phases_s", phases)?;
         Ok(d)
     }
 

@@ -203,7 +203,7 @@ def test_timers_count_the_rust_side_of_each_step_call(tissue: Simulation) -> Non
     t = tissue.timers
     assert set(t) == {
         "calls", "steps", "tissue_updates", "simulated_s", "wall_s", "tissue_wall_s",
-        "muscles_wall_s", "realtime_factor",
+        "muscles_wall_s", "realtime_factor", "tissue_phases_s",
     }
     assert (t["calls"], t["steps"]) == (40, 40)
     assert t["simulated_s"] == pytest.approx(0.04, rel=1e-12)
@@ -212,6 +212,17 @@ def test_timers_count_the_rust_side_of_each_step_call(tissue: Simulation) -> Non
     assert 0.0 < t["tissue_wall_s"] < t["wall_s"]
     assert t["muscles_wall_s"] == pytest.approx(t["wall_s"] - t["tissue_wall_s"])
     assert t["realtime_factor"] == pytest.approx(t["simulated_s"] / t["wall_s"])
+    # The phases, in update order, take all of the tissue's time but a finiteness check.
+    phases = t["tissue_phases_s"]
+    assert list(phases) == [
+        "muscle_shapes", "knee_fold", "first_guess", "shape_matching", "bone_sliding", "guard",
+    ]
+    seconds = [
+        phases["muscle_shapes"], phases["knee_fold"], phases["first_guess"],
+        phases["shape_matching"], phases["bone_sliding"], phases["guard"],
+    ]
+    assert all(s > 0.0 for s in seconds)
+    assert 0.9 * t["tissue_wall_s"] < sum(seconds) <= t["tissue_wall_s"]
     # Checkpoints are about the model, timers about the machine.
     tissue.set_state(tissue.state())
     assert tissue.timers == t

@@ -142,6 +142,15 @@ fn muscle_volumes_stay_within_one_percent(lattice: Lattice) {
     let timers = sim.timers();
     assert!(timers.tissue_updates > 0 && timers.tissue_updates <= timers.steps);
     assert!(timers.tissue_wall_s > 0.0 && timers.tissue_wall_s < timers.wall_s);
+    // Every phase takes time, and together all of the tissue's but a call's backup and
+    // the finiteness checks.
+    let phases = timers.tissue_phases;
+    assert!(phases.named().iter().all(|(_, s)| *s > 0.0), "{phases:?}");
+    let share = phases.total_s() / timers.tissue_wall_s;
+    assert!(
+        share > 0.9 && share <= 1.0,
+        "{phases:?}: {share} of the tissue's time"
+    );
     let lo = range.iter().map(|r| r.0).fold(1.0, f32::min);
     let hi = range.iter().map(|r| r.1).fold(1.0, f32::max);
     let outside: Vec<String> = names

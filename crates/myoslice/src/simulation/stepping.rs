@@ -64,14 +64,15 @@ impl Simulation {
             if self.tissue.as_mut().is_some_and(|t| t.advance_clock(h)) {
                 let t0 = Instant::now();
                 let angle = self.knee_angle();
-                let updated = match &mut self.tissue {
+                let (updated, phases) = match &mut self.tissue {
                     Some(t) => {
                         tissue_backup.get_or_insert_with(|| t.backup());
-                        t.update_unguarded(angle, &self.frames, &self.muscles)
+                        let ok = t.update_unguarded(angle, &self.frames, &self.muscles);
+                        (ok, t.last_phases)
                     }
-                    None => true,
+                    None => (true, Default::default()),
                 };
-                self.timers.add_tissue(t0.elapsed());
+                self.timers.add_tissue(t0.elapsed(), &phases);
                 if !updated {
                     failure = Some("fat or muscle shape".into());
                     break;

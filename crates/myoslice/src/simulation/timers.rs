@@ -2,9 +2,11 @@
 
 use std::time::Duration;
 
+use crate::tissue::TissuePhases;
+
 /// Wall-clock time spent inside [`Simulation::step`](crate::Simulation::step) since the
 /// simulation was built (a clone starts with its original's) or the timers were reset,
-/// split into the tissue updates and the rest (muscles and skeleton).
+/// split into the tissue updates (phase by phase) and the rest (muscles and skeleton).
 ///
 /// They measure the machine, not the model: they are never part of a checkpoint, and
 /// `set_state` leaves them alone. Reading them from Python next to a timer of the call
@@ -30,6 +32,9 @@ pub struct StepTimers {
     pub wall_s: f64,
     /// Of `wall_s`, the part spent updating the tissue (s).
     pub tissue_wall_s: f64,
+    /// Of `tissue_wall_s`, each phase of the updates (the rest is the backup a call
+    /// takes before its first update and the check that everything stayed finite).
+    pub tissue_phases: TissuePhases,
 }
 
 impl StepTimers {
@@ -51,10 +56,11 @@ impl StepTimers {
         self.wall_s += wall.as_secs_f64();
     }
 
-    /// Records one tissue update within a call.
-    pub(crate) fn add_tissue(&mut self, wall: Duration) {
+    /// Records one tissue update within a call, and its phases.
+    pub(crate) fn add_tissue(&mut self, wall: Duration, phases: &TissuePhases) {
         self.tissue_updates += 1;
         self.tissue_wall_s += wall.as_secs_f64();
+        self.tissue_phases.add(phases);
     }
 }
 
@@ -66,7 +72,12 @@ mod tests {
     fn muscle_time_is_what_the_tissue_leaves() {
         let mut t = StepTimers::default();
         t.add_call(Duration::from_millis(30), 30, 0.03);
-        t.add_tissue(Duration::from_millis(10));
+        let phases = TissuePhases {
+            guard_s: 0.004,
+            ..Default::default()
+        };
+        t.add_tissue(Duration::from_millis(10), &phases);
+        assert_eq!(t.tissue_phases, phases);
         assert_eq!((t.calls, t.steps, t.tissue_updates), (1, 30, 1));
         assert!((t.muscles_wall_s() - 0.02).abs() < 1e-12);
         assert!((t.realtime_factor().unwrap_or(0.0) - 1.0).abs() < 1e-9);

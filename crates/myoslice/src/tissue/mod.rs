@@ -12,6 +12,7 @@ pub mod intersect;
 pub mod knee_fold;
 pub mod metrics;
 pub mod muscle_shape;
+mod phases;
 pub mod polar;
 mod skin_breach;
 
@@ -27,6 +28,8 @@ pub use knee_fold::{Contact, FoldZone, KneeFold};
 use metrics::LazyMetrics;
 pub use metrics::TissueMetrics;
 pub use muscle_shape::MuscleShape;
+use phases::Lap;
+pub use phases::TissuePhases;
 use skin_breach::ClosedSkin;
 pub use skin_breach::SkinBreach;
 
@@ -182,6 +185,8 @@ pub struct Tissue {
     metrics: LazyMetrics,
     /// Time accumulated since the last update (s).
     pub(crate) pending: f64,
+    /// How long each phase of the last update took.
+    pub(crate) last_phases: TissuePhases,
 }
 
 /// A tissue's changing state, to put back after a failed update or `step` call.
@@ -290,6 +295,7 @@ impl Tissue {
             layers: fat.layers,
             metrics: LazyMetrics::built(),
             pending: 0.0,
+            last_phases: TissuePhases::default(),
         };
         Ok(tissue)
     }
@@ -409,6 +415,8 @@ impl Tissue {
     }
 
     fn deform(&mut self, knee_angle: f64, frames: &BodyFrames, muscles: &[MuscleUnit]) {
+        let mut lap = Lap::start();
+        let mut phases = TissuePhases::default();
         let theta = knee_angle as f32;
         let fold = KneeFold::new(&self.knee, theta);
         let (tq, tt) = frames.thigh;
@@ -448,6 +456,7 @@ impl Tissue {
                     _ => shape.update_clear_of(&m.chain, &fold, &bones),
                 }
             });
+        phases.muscle_shapes_s = lap.lap();
         let mut sc = std::mem::take(&mut self.scratch);
         // The fold of the rest shape is valid: the fallback of the guard below.
         knee_fold::fold_hexes(
@@ -459,6 +468,7 @@ impl Tissue {
             &mut sc.safe,
             &mut sc.weights,
         );
+        phases.knee_fold_s = lap.lap();
         let (safe, weights) = (&sc.safe, &sc.weights);
         // Where each inner vertex facing a muscle goes: with its reference muscle vertex,
         // keeping its rest offset from it turned as the tissue about it turns (the
@@ -498,6 +508,7 @@ impl Tissue {
                 *g += normal + along * (1.0 - 0.5 * l as f32 / layers as f32);
             }
         }
+        phases.first_guess_s = lap.lap();
         let guess = &sc.guess;
         self.fat
             .x
@@ -542,6 +553,7 @@ impl Tissue {
             self.apply_muscles(targets);
             self.apply_contact(&contact, gap);
         }
+        phases.shape_matching_s = lap.lap();
         let pose = |b: BodyId| match b {
             BodyId::Thigh => frames.thigh,
             BodyId::Shank => frames.shank,
@@ -554,6 +566,7 @@ impl Tissue {
             pose,
         );
         self.apply_contact(&contact, gap);
+        phases.bone_sliding_s = lap.lap();
         let guarded = sc.guard.run(
             &mut self.fat,
             safe,
@@ -567,6 +580,8 @@ impl Tissue {
         self.theta = theta;
         self.scratch = sc;
         self.metrics = LazyMetrics::updated(guarded);
+        phases.guard_s = lap.lap();
+        self.last_phases = phases;
     }
 
     /// Pulls inner vertices facing a muscle toward their targets (the paper's rule, see
