@@ -212,7 +212,8 @@ def test_timers_count_the_rust_side_of_each_step_call(tissue: Simulation) -> Non
     assert 0.0 < t["tissue_wall_s"] < t["wall_s"]
     assert t["muscles_wall_s"] == pytest.approx(t["wall_s"] - t["tissue_wall_s"])
     assert t["realtime_factor"] == pytest.approx(t["simulated_s"] / t["wall_s"])
-    # The phases, in update order, take all of the tissue's time but a finiteness check.
+    # The phases, in update order, take all of the tissue's time but a call's backup and
+    # the finiteness checks.
     phases = t["tissue_phases_s"]
     assert list(phases) == [
         "muscle_shapes", "knee_fold", "first_guess", "shape_matching", "bone_sliding", "guard",
@@ -222,7 +223,7 @@ def test_timers_count_the_rust_side_of_each_step_call(tissue: Simulation) -> Non
         phases["shape_matching"], phases["bone_sliding"], phases["guard"],
     ]
     assert all(s > 0.0 for s in seconds)
-    assert 0.9 * t["tissue_wall_s"] < sum(seconds) <= t["tissue_wall_s"]
+    assert 0.9 * t["tissue_wall_s"] < sum(seconds) <= t["tissue_wall_s"] + 1e-9
     # Checkpoints are about the model, timers about the machine.
     tissue.set_state(tissue.state())
     assert tissue.timers == t

@@ -126,7 +126,8 @@ pub(crate) struct BoneKeepOut {
     /// Shift of each ring (world, m).
     pub(crate) shift: Vec<Vec3>,
     /// Work buffers: the shift each ring needs this update, and that spread to its
-    /// neighbours.
+    /// neighbours (what the last [`Self::push_out`] moved each ring by: zero when it
+    /// moved nothing).
     need: Vec<Vec3>,
     pub(crate) spread: Vec<Vec3>,
 }
@@ -265,7 +266,11 @@ impl BoneKeepOut {
             }
             deep = Some(deep.unwrap_or(0) + usize::from(d.length_squared() > 1e-6));
         }
-        deep?;
+        if deep.is_none() {
+            // Nothing moved: a call `again` after this one must find every ring still.
+            self.spread.iter_mut().for_each(|s| *s = Vec3::ZERO);
+            return None;
+        }
         let rings = self.need.len();
         for r in 0..rings {
             let mut total = self.need[r];
@@ -298,10 +303,12 @@ pub struct BoneOverlap {
     pub deepest_m: f32,
 }
 
-/// Measures `vertices` against every bone (exact: a tree query per vertex near a bone).
-/// `crossed[b]` says bone `b`'s surface crosses itself (tubes of one bone overlapping,
-/// or a tube folding): there the pseudo-normal can call a point outside inside, so the
-/// winding number confirms it.
+/// Measures `vertices` against every bone (a tree query per vertex near a bone; exact
+/// for a surface that does not cross itself). `crossed[b]` says bone `b`'s surface
+/// crosses itself (tubes of one bone overlapping, or a tube folding): there the
+/// pseudo-normal can call a point outside inside, so the winding number confirms it;
+/// it can still miss a point inside one tube whose nearest surface is another tube's
+/// wall running inside it, and measures depth to that wall (a lower bound).
 pub(crate) fn overlap(vertices: &[Vec3], bones: &Bones, crossed: &[bool]) -> BoneOverlap {
     let mut o = BoneOverlap::default();
     for (b, (body, mesh)) in bones.surfaces.iter().enumerate() {

@@ -265,6 +265,12 @@ pub(crate) struct BoneSlide {
 impl BoneSlide {
     /// Binds each `(fat vertex, bone)` at its rest position.
     pub(crate) fn new(pairs: &[(u32, u32)], rest: &[Vec3], bones: &[(BodyId, TriMesh)]) -> Self {
+        // Each vertex once: `apply` pulls them in parallel and writes each back once.
+        debug_assert!({
+            let mut v: Vec<u32> = pairs.iter().map(|p| p.0).collect();
+            v.sort_unstable();
+            v.windows(2).all(|w| w[0] != w[1])
+        });
         let mut vertices = Vec::with_capacity(pairs.len());
         let mut nearest = Vec::with_capacity(pairs.len());
         for &(v, b) in pairs {

@@ -130,7 +130,8 @@ impl Guard {
                 }
                 let live = &self.live;
                 let queried = |i: u32| live[i as usize];
-                // A grid pays for itself only for many queries (the first round).
+                // A grid pays for itself only for many queries; after the first round it
+                // covers only the triangles near the queried ones.
                 let pairs = if round > 0 && self.query.len() > FEW {
                     crossing_pairs_near(&fat.x, triangles, &self.boxes, &self.query, queried)
                 } else if self.query.len() > FEW {

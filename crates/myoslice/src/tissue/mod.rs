@@ -318,8 +318,11 @@ impl Tissue {
     }
 
     /// How far each muscle's surface reaches into bone with the bodies at `frames`, in
-    /// muscle order (exact, one tree query per muscle vertex near a bone, and a winding
-    /// number where a bone's surface crosses itself: for checks, not for every update).
+    /// muscle order (one tree query per muscle vertex near a bone, and a winding number
+    /// where a bone's surface crosses itself; exact but for points inside one tube of a
+    /// bone whose nearest surface is another tube's wall: for checks, not for every
+    /// update; the first call also finds which bone surfaces cross themselves, about
+    /// 15 ms).
     pub fn muscles_in_bone(&self, frames: &BodyFrames) -> Vec<BoneOverlap> {
         let bones = Bones {
             meshes: &self.fixed.bone_meshes,

@@ -19,8 +19,8 @@ pub struct TissuePhases {
     pub knee_fold_s: f64,
     /// Where the fat facing a muscle goes, and the first guess.
     pub first_guess_s: f64,
-    /// Restriction to the region that moves, and the shape-matching iterations with
-    /// their muscle and contact constraints.
+    /// The momentum carried into the guess, the restriction to the region that moves,
+    /// and the shape-matching iterations with their muscle and contact constraints.
     pub shape_matching_s: f64,
     /// Fat sliding on bone.
     pub bone_sliding_s: f64,
