@@ -266,9 +266,10 @@ fn muscles_in_bone_through_a_deep_flexion(mut sim: Simulation) -> (usize, usize,
 fn muscles_are_kept_out_of_bone_through_a_deep_flexion() {
     let sim = Simulation::phantom(SimulationConfig::default()).unwrap();
     let (_, added, deepest) = muscles_in_bone_through_a_deep_flexion(sim);
-    // Without the rings' shifts: about 2 700 more vertices, 19 mm deep.
+    // Without the rings' shifts: about 2 700 more vertices, 19 mm deep; with rings that
+    // straddle a bone shifted by their largest push, 14.7 mm deep.
     assert!(
-        added < 400 && deepest < 0.016,
+        added < 400 && deepest < 0.012,
         "{added} more muscle vertices than at rest > 1 mm inside bone, the deepest {:.1} mm",
         deepest * 1e3
     );
@@ -287,7 +288,7 @@ fn visible_human_muscles_are_kept_out_of_bone_through_a_deep_flexion() {
     .unwrap();
     let (at_rest, added, deepest) = muscles_in_bone_through_a_deep_flexion(sim);
     assert!(
-        at_rest == 0 && added < 400 && deepest < 0.016,
+        at_rest == 0 && added < 400 && deepest < 0.012,
         "{at_rest} muscle vertices > 1 mm inside bone at rest, at most {added} more, the \
          deepest {:.1} mm",
         deepest * 1e3
@@ -481,10 +482,18 @@ fn muscles_reach_out_through_the_skin_no_further_than_recorded_in_a_deep_flexion
     let mut sim = Simulation::phantom(SimulationConfig::default()).unwrap();
     let (mut most, mut farthest) = (0usize, 0.0f32);
     let mut below_70 = 0usize;
+    // While the knee first bends to 45°: rings pushed off a bone from both sides ran away
+    // (the vastus medialis came 21 mm out).
+    let (mut top, mut rising_45) = (0.0f64, 0.0f32);
     flex_and_back(&mut sim, 1.0, |s| {
         let out = s.muscles_outside_skin().unwrap();
         let count: usize = out.iter().map(|b| b.vertices_over_1mm).sum();
         let far = out.iter().map(|b| b.farthest_m).fold(0.0, f32::max);
+        let angle = s.knee_angle().to_degrees();
+        top = top.max(angle);
+        if angle < 45.0 && angle > top - 1.0 {
+            rising_45 = rising_45.max(far);
+        }
         eprintln!(
             "{:6.1}°: {count} muscle vertices > 1 mm outside the skin, the farthest {:.1} mm",
             s.knee_angle().to_degrees(),
@@ -498,8 +507,14 @@ fn muscles_reach_out_through_the_skin_no_further_than_recorded_in_a_deep_flexion
     });
     eprintln!(
         "at most {most} muscle vertices > 1 mm outside the skin ({below_70} below 70°), the \
-         farthest {:.1} mm",
-        farthest * 1e3
+         farthest {:.1} mm ({:.1} mm while first bending to 45°)",
+        farthest * 1e3,
+        rising_45 * 1e3
+    );
+    assert!(
+        rising_45 < 0.012,
+        "{:.1} mm out while bending to 45°",
+        rising_45 * 1e3
     );
     assert!(
         most < 13_000 && below_70 < 3_000 && farthest < 0.06,

@@ -27,6 +27,8 @@ const MARGIN_M: f32 = 0.001;
 /// Share of a ring's shift given to its neighbours 1, 2, 3... rings away (the surface
 /// bends over several rings rather than stepping: a step creased the skin over it).
 const SPREAD: [f32; 3] = [0.75, 0.5, 0.25];
+/// Most rounds of shifting rings out of bone per update.
+const PUSH_ROUNDS: usize = 8;
 /// Share of a ring's shift kept over a thirtieth of a second (one update at the default
 /// rate).
 const FADE: f32 = 0.9;
@@ -130,6 +132,12 @@ pub(crate) struct BoneKeepOut {
     /// moved nothing).
     need: Vec<Vec3>,
     pub(crate) spread: Vec<Vec3>,
+    /// Work buffers: every push of the round (ring, push), and per ring the largest push
+    /// against its largest (see [`Self::push_out`]).
+    pushes: Vec<(u32, Vec3)>,
+    against: Vec<f32>,
+    /// What [`Self::clear_rings`] moved each ring by.
+    moved: Vec<Vec3>,
 }
 
 /// What a [`BoneKeepOut`] carries from one update to the next: the rings' shifts and what
@@ -205,6 +213,9 @@ impl BoneKeepOut {
             shift: vec![Vec3::ZERO; rings],
             need: vec![Vec3::ZERO; rings],
             spread: vec![Vec3::ZERO; rings],
+            pushes: Vec::new(),
+            against: vec![0.0; rings],
+            moved: vec![Vec3::ZERO; rings],
         }
     }
 
@@ -218,6 +229,37 @@ impl BoneKeepOut {
         self.shift.iter_mut().for_each(|s| *s = Vec3::ZERO);
     }
 
+    /// Shifts the rings out of the bones in up to [`PUSH_ROUNDS`] rounds of
+    /// [`Self::push_out`] (a shift can move a ring's other vertices in) and returns how far
+    /// each ring moved in all.
+    pub(crate) fn clear_rings(
+        &mut self,
+        current: &mut [Vec3],
+        ring_of: &[u32],
+        axis: impl Fn(usize) -> Vec3,
+        bones: &Bones,
+    ) -> &[Vec3] {
+        self.moved.clear();
+        self.moved.resize(self.shift.len(), Vec3::ZERO);
+        let mut last = usize::MAX;
+        for round in 0..PUSH_ROUNDS {
+            let Some(deep) = self.push_out(current, ring_of, &axis, bones, round > 0) else {
+                break;
+            };
+            for (m, s) in self.moved.iter_mut().zip(&self.spread) {
+                *m += *s;
+            }
+            // A round that finds no fewer vertices over 1 mm deep than the last is the
+            // last: rings pushing each other back in (as one wrapped round a bone does)
+            // would use every round for nothing.
+            if deep >= last {
+                break;
+            }
+            last = deep;
+        }
+        &self.moved
+    }
+
     /// Finds the rings a bone reaches into, shifts them out (a neighbour as far as the
     /// largest of [`SPREAD`]'s shares of the rings near it, so the surface bends rather
     /// than steps) and moves their vertices in `current` with them. Returns how many of
@@ -228,7 +270,7 @@ impl BoneKeepOut {
     ///
     /// `again` says the last call was this update's previous round: then only the
     /// vertices that call moved are looked at (the others would be found as they were).
-    pub(crate) fn push_out(
+    fn push_out(
         &mut self,
         current: &mut [Vec3],
         ring_of: &[u32],
@@ -237,6 +279,7 @@ impl BoneKeepOut {
         again: bool,
     ) -> Option<usize> {
         self.need.iter_mut().for_each(|n| *n = Vec3::ZERO);
+        self.pushes.clear();
         let mut deep: Option<usize> = None;
         for (&(v, b), w) in self.pairs.iter().zip(&mut self.watch) {
             if again && self.spread[ring_of[v as usize] as usize] == Vec3::ZERO {
@@ -260,6 +303,7 @@ impl BoneKeepOut {
             if push == Vec3::ZERO {
                 continue; // the bone's normal runs along the muscle: nothing across
             }
+            self.pushes.push((r as u32, push));
             let need = &mut self.need[r];
             if push.length_squared() > need.length_squared() {
                 *need = push;
@@ -270,6 +314,22 @@ impl BoneKeepOut {
             // Nothing moved: a call `again` after this one must find every ring still.
             self.spread.iter_mut().for_each(|s| *s = Vec3::ZERO);
             return None;
+        }
+        // A ring that bone reaches into from opposite sides straddles it: no shift clears
+        // it, and shifting it by its largest push ran away update after update (7 cm for
+        // the phantom's vastus medialis by the femur, out through the skin). It moves by
+        // the difference: its largest push less the largest against it.
+        self.against.iter_mut().for_each(|a| *a = 0.0);
+        for &(r, push) in &self.pushes {
+            let r = r as usize;
+            let against = -push.dot(self.need[r].normalize_or_zero());
+            self.against[r] = self.against[r].max(against);
+        }
+        for (n, &a) in self.need.iter_mut().zip(&self.against) {
+            if a > 0.0 {
+                let len = n.length();
+                *n *= ((len - a) / len).max(0.0);
+            }
         }
         let rings = self.need.len();
         for r in 0..rings {
@@ -334,4 +394,114 @@ pub(crate) fn overlap(vertices: &[Vec3], bones: &Bones, crossed: &[bool]) -> Bon
         }
     }
     o
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A box bone `lo..hi` (m), outward triangles.
+    fn box_bone(lo: Vec3, hi: Vec3) -> (BodyId, TriMesh) {
+        let v: Vec<Vec3> = (0..8)
+            .map(|i| {
+                Vec3::new(
+                    if i & 1 == 0 { lo.x } else { hi.x },
+                    if i & 2 == 0 { lo.y } else { hi.y },
+                    if i & 4 == 0 { lo.z } else { hi.z },
+                )
+            })
+            .collect();
+        let quads = [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        let t: Vec<[u32; 3]> = quads
+            .iter()
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .collect();
+        let mesh = TriMesh::new(v, t).unwrap_or_else(|e| panic!("{e}"));
+        (BodyId::Thigh, mesh)
+    }
+
+    /// Rings of 32 vertices round the z axis, `RINGS` of them 2 mm apart from z = 0, with
+    /// semi-axes `a` (x) and `b` (y), shifted along z by `dz`.
+    const RINGS: usize = 5;
+    fn rings(a: f32, b: f32, dz: f32) -> (Vec<Vec3>, Vec<u32>) {
+        let mut p = Vec::new();
+        let mut ring_of = Vec::new();
+        for r in 0..RINGS {
+            for k in 0..32 {
+                let t = k as f32 / 32.0 * std::f32::consts::TAU;
+                p.push(Vec3::new(a * t.cos(), b * t.sin(), dz + 0.002 * r as f32));
+                ring_of.push(r as u32);
+            }
+        }
+        (p, ring_of)
+    }
+
+    /// Runs `updates` updates as a muscle shape does: the rings placed at `base` plus
+    /// their faded shifts, then pushed out round after round. Returns the largest shift.
+    fn run(
+        keep: &mut BoneKeepOut,
+        base: &[Vec3],
+        ring_of: &[u32],
+        bones: &Bones,
+        updates: usize,
+    ) -> f32 {
+        for _ in 0..updates {
+            keep.fade(bones.fade);
+            let mut current: Vec<Vec3> = base
+                .iter()
+                .zip(ring_of)
+                .map(|(p, &r)| *p + keep.shift[r as usize])
+                .collect();
+            keep.clear_rings(&mut current, ring_of, |_| Vec3::Z, bones);
+        }
+        keep.shift.iter().map(|s| s.length()).fold(0.0, f32::max)
+    }
+
+    #[test]
+    fn a_ring_a_bone_reaches_into_from_opposite_sides_is_not_pushed_away() {
+        // A bone 20 mm wide ahead of the rings along their axis (clear of them at rest);
+        // the rings then move 12 mm along and flatten to 8 mm across in y, so the bone
+        // reaches 2 mm into each ring from both sides at once.
+        let bones = [box_bone(
+            Vec3::new(-0.01, -0.01, 0.005),
+            Vec3::new(0.01, 0.01, 0.05),
+        )];
+        let meshes = [BoneMesh::new(bones[0].0, &bones[0].1)];
+        let frames = BodyFrames::REST;
+        let b = Bones {
+            meshes: &meshes,
+            surfaces: &bones,
+            frames: &frames,
+            fade: fade_per_update(30.0),
+        };
+        let (rest, ring_of) = rings(0.015, 0.015, 0.0);
+        let mut keep = BoneKeepOut::new(&rest, RINGS, &bones, &meshes, Vec3::splat(10.0));
+        assert!(!keep.pairs.is_empty(), "no vertex watched");
+        let (flat, _) = rings(0.015, 0.008, 0.012);
+        let far = run(&mut keep, &flat, &ring_of, &b, 30);
+        assert!(far < 1e-4, "a straddling ring moved {:.1} mm", far * 1e3);
+        // Reached from one side only (the flat rings 15 mm up in y, their lowest vertices
+        // 3 mm into the bone), they are pushed clear on that side.
+        let one_sided: Vec<Vec3> = flat
+            .iter()
+            .map(|p| *p + Vec3::new(0.0, 0.015, 0.0))
+            .collect();
+        let mut keep = BoneKeepOut::new(&rest, RINGS, &bones, &meshes, Vec3::splat(10.0));
+        let moved = run(&mut keep, &one_sided, &ring_of, &b, 1);
+        assert!(
+            moved > 0.003,
+            "a ring reached from one side moved {:.1} mm",
+            moved * 1e3
+        );
+        for r in 0..RINGS {
+            assert!(keep.shift[r].y > 0.0, "ring {r}: {:?}", keep.shift[r]);
+        }
+    }
 }

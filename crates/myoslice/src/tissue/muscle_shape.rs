@@ -15,9 +15,6 @@ use crate::muscle::MuscleChain;
 /// were shifted far out of bone (plantaris by the condyle) needed more than five.
 const VOLUME_PASSES: usize = 12;
 
-/// Most rounds of shifting rings out of bone per update.
-const PUSH_ROUNDS: usize = 8;
-
 /// Where a ring rides on the chain and how its vertices sit around it.
 #[derive(Debug, Clone)]
 pub struct MuscleShape {
@@ -225,25 +222,11 @@ impl MuscleShape {
             if pass == 0
                 && let Some(b) = bones
             {
-                let mut last = usize::MAX;
-                for round in 0..PUSH_ROUNDS {
-                    let axis = |r: usize| rings[r].2;
-                    let Some(deep) =
-                        self.keep
-                            .push_out(&mut self.current, &self.ring_of, axis, b, round > 0)
-                    else {
-                        break;
-                    };
-                    for (ring, s) in rings.iter_mut().zip(&self.keep.spread) {
-                        ring.0 += *s;
-                    }
-                    // A round that finds no fewer vertices over 1 mm deep than the last is
-                    // the last: rings pushing each other back in (as one wrapped round a
-                    // bone does) would use every round for nothing.
-                    if deep >= last {
-                        break;
-                    }
-                    last = deep;
+                let moved =
+                    self.keep
+                        .clear_rings(&mut self.current, &self.ring_of, |r| rings[r].2, b);
+                for (ring, m) in rings.iter_mut().zip(moved) {
+                    ring.0 += *m;
                 }
             }
             // What the piecewise map still gains or loses, the cross-sections give back:
