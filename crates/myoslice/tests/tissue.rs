@@ -475,51 +475,66 @@ fn a_muscle_moved_out_of_the_body_is_found_outside_the_skin() {
     assert!(out[1..].iter().all(|b| b.vertices_over_1mm == 0));
 }
 
-/// A regression bound, not a goal: the fold drags the skin behind the knee further
-/// round than the muscles under it (see the README), and the bound records how far.
-#[test]
-fn muscles_reach_out_through_the_skin_no_further_than_recorded_in_a_deep_flexion() {
-    let mut sim = Simulation::phantom(SimulationConfig::default()).unwrap();
-    let (mut most, mut farthest) = (0usize, 0.0f32);
-    let mut below_70 = 0usize;
-    // While the knee first bends to 45°: rings pushed off a bone from both sides ran away
-    // (the vastus medialis came 21 mm out).
-    let (mut top, mut rising_45) = (0.0f64, 0.0f32);
+/// Checks how far muscles reach out through the skin over the tissue tests' flexion
+/// against the bound recorded: the most vertices more than 1 mm out at one update (and
+/// below 70°), the farthest, and the farthest while the knee first bends to 45°.
+///
+/// A regression bound, not a goal: the fold drags the skin behind the knee further round
+/// than the muscles under it (see the README), and the bound records how far. While the
+/// knee first bends to 45° it is tighter: rings pushed off a bone from both sides ran
+/// away (the phantom's vastus medialis came 21 mm out).
+fn muscles_reach_out_no_further_than_recorded(mut sim: Simulation) {
+    let (mut most, mut below_70, mut farthest, mut rising_45) = (0usize, 0usize, 0.0f32, 0.0f32);
+    let mut top = 0.0f64;
     flex_and_back(&mut sim, 1.0, |s| {
         let out = s.muscles_outside_skin().unwrap();
         let count: usize = out.iter().map(|b| b.vertices_over_1mm).sum();
         let far = out.iter().map(|b| b.farthest_m).fold(0.0, f32::max);
         let angle = s.knee_angle().to_degrees();
+        eprintln!(
+            "{angle:6.1}°: {count} muscle vertices > 1 mm outside the skin, the farthest {:.1} mm",
+            far * 1e3
+        );
         top = top.max(angle);
         if angle < 45.0 && angle > top - 1.0 {
             rising_45 = rising_45.max(far);
         }
-        eprintln!(
-            "{:6.1}°: {count} muscle vertices > 1 mm outside the skin, the farthest {:.1} mm",
-            s.knee_angle().to_degrees(),
-            far * 1e3
-        );
         most = most.max(count);
         farthest = farthest.max(far);
-        if s.knee_angle().to_degrees() < 70.0 {
+        if angle < 70.0 {
             below_70 = below_70.max(count);
         }
     });
-    eprintln!(
+    let summary = format!(
         "at most {most} muscle vertices > 1 mm outside the skin ({below_70} below 70°), the \
          farthest {:.1} mm ({:.1} mm while first bending to 45°)",
         farthest * 1e3,
         rising_45 * 1e3
     );
+    eprintln!("{summary}");
     assert!(
-        rising_45 < 0.012,
-        "{:.1} mm out while bending to 45°",
-        rising_45 * 1e3
+        rising_45 < 0.012 && most < 13_000 && below_70 < 3_000 && farthest < 0.06,
+        "{summary}"
     );
-    assert!(
-        most < 13_000 && below_70 < 3_000 && farthest < 0.06,
-        "{most} muscle vertices > 1 mm outside the skin ({below_70} below 70°), the farthest \
-         {:.1} mm",
-        farthest * 1e3
+}
+
+#[test]
+fn muscles_reach_out_through_the_skin_no_further_than_recorded_in_a_deep_flexion() {
+    muscles_reach_out_no_further_than_recorded(
+        Simulation::phantom(SimulationConfig::default()).unwrap(),
     );
+}
+
+#[test]
+fn visible_human_muscles_reach_out_through_the_skin_no_further_than_recorded() {
+    let Some(lattice) = common::vh_lattice() else {
+        return;
+    };
+    let sim = Simulation::new(
+        lattice.clone(),
+        SimulationConfig::default(),
+        &MuscleCatalogue::default(),
+    )
+    .unwrap();
+    muscles_reach_out_no_further_than_recorded(sim);
 }
