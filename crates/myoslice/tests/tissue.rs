@@ -475,6 +475,44 @@ fn a_muscle_moved_out_of_the_body_is_found_outside_the_skin() {
     assert!(out[1..].iter().all(|b| b.vertices_over_1mm == 0));
 }
 
+/// `step` moves the muscles and the skeleton on while a tissue update runs its guard;
+/// stepped one update per call, nothing runs beside it. Both give the same bits.
+#[test]
+fn muscles_stepping_beside_the_guard_give_the_same_bits_as_one_after_the_other() {
+    // Steps and updates of exact binary fractions of a second: both runs add up the same
+    // clock.
+    let mut cfg = SimulationConfig::default();
+    cfg.max_step_s = 1.0 / 1024.0;
+    cfg.tissue.rate_hz = 32.0;
+    let mut beside = Simulation::phantom(cfg).unwrap();
+    for m in [
+        "semitendinosus",
+        "biceps_femoris_long",
+        "gastrocnemius_medial",
+    ] {
+        beside.set_excitation(m, 1.0).unwrap();
+    }
+    let mut after = beside.clone();
+    beside.step(0.5).unwrap();
+    for _ in 0..16 {
+        after.step(1.0 / 32.0).unwrap();
+    }
+    assert_eq!(beside.timers().tissue_updates, 16);
+    assert_eq!(after.timers().tissue_updates, 16);
+    assert!(beside.knee_angle() > 0.2, "{}", beside.knee_angle());
+    let bits = |s: &Simulation| -> Vec<u32> {
+        let muscles = (0..s.muscles().len()).flat_map(|i| s.muscle_vertices(i));
+        s.fat_vertices()
+            .iter()
+            .copied()
+            .chain(muscles)
+            .flat_map(|p| p.to_array().map(f32::to_bits))
+            .collect()
+    };
+    assert_eq!(beside.knee_angle().to_bits(), after.knee_angle().to_bits());
+    assert!(bits(&beside) == bits(&after), "the tissue differs");
+}
+
 /// Checks how far muscles reach out through the skin over the tissue tests' flexion
 /// against the bound recorded: the most vertices more than 1 mm out at one update (and
 /// below 70°), the farthest, and the farthest while the knee first bends to 45°.

@@ -34,6 +34,10 @@ impl Simulation {
     /// `max_step_s`). If anything becomes non-finite, the whole simulation (muscles,
     /// skeleton, tissue and clocks) goes back to its state before the call and an error
     /// says what failed.
+    ///
+    /// While a tissue update runs its validity guard, the muscles and the skeleton take
+    /// their steps to the next update on another thread: the guard reads neither, so the
+    /// results are those of running one after the other, bit for bit.
     pub fn step(&mut self, dt: f64) -> Result<()> {
         check_positive("dt", dt)?;
         if dt > 10.0 {
@@ -51,45 +55,67 @@ impl Simulation {
         let saved = (self.time, self.steps, self.frames, self.knee_torque);
         // The tissue's clock at the start, so that its updates fall where a twin that
         // never failed has them.
-        let clock = self.tissue.as_ref().map(|t| t.pending);
+        let clock = self.tissue.as_ref().map(|t| (t.pending, t.period()));
+        let mut pending = clock.map(|(p, _)| p);
+        let period = clock.map_or(f64::INFINITY, |(_, p)| p);
         let mut tissue_backup: Option<TissueBackup> = None;
-        let mut failure = None;
         let mut taken = 0;
-        for _ in 0..n {
-            taken += 1;
-            if let Some(what) = self.substep(h).or_else(|| self.non_finite()) {
-                failure = Some(what);
+        // (when, what) of the first failure.
+        let mut failure: Option<(f64, String)> = None;
+        let mut due = match self.segment(n, h, &mut taken, pending.as_mut(), period) {
+            Ok(due) => due,
+            Err(f) => {
+                failure = Some(f);
+                false
+            }
+        };
+        while due {
+            let Some(mut t) = self.tissue.take() else {
+                break;
+            };
+            let t0 = Instant::now();
+            tissue_backup.get_or_insert_with(|| t.backup());
+            let (angle, when) = (self.knee_angle(), self.time);
+            let front = t.update_front(angle, &self.frames, &self.muscles);
+            let front_s = t0.elapsed();
+            // The guard never reads the skeleton or the muscles: they step on to the next
+            // update beside it (their steps are serial and the guard mostly so, so each
+            // fills the other's idle core). Same results as one after the other.
+            let ((updated, back_s), next) = rayon::join(
+                || {
+                    let t1 = Instant::now();
+                    let ok = t.update_back(front);
+                    (ok, t1.elapsed())
+                },
+                || self.segment(n, h, &mut taken, pending.as_mut(), period),
+            );
+            self.timers.add_tissue(front_s + back_s, &t.last_phases);
+            self.tissue = Some(t);
+            if !updated {
+                failure = Some((when, "fat or muscle shape".into()));
                 break;
             }
-            if self.tissue.as_mut().is_some_and(|t| t.advance_clock(h)) {
-                let t0 = Instant::now();
-                let angle = self.knee_angle();
-                let (updated, phases) = match &mut self.tissue {
-                    Some(t) => {
-                        tissue_backup.get_or_insert_with(|| t.backup());
-                        let ok = t.update_unguarded(angle, &self.frames, &self.muscles);
-                        (ok, t.last_phases)
-                    }
-                    None => (true, Default::default()),
-                };
-                self.timers.add_tissue(t0.elapsed(), &phases);
-                if !updated {
-                    failure = Some("fat or muscle shape".into());
+            match next {
+                Ok(d) => due = d,
+                Err(f) => {
+                    failure = Some(f);
                     break;
                 }
             }
         }
+        if let (Some(t), Some(p)) = (&mut self.tissue, pending) {
+            t.pending = p;
+        }
         let result = match failure {
             None => Ok(()),
-            Some(what) => {
-                let time = self.time;
+            Some((time, what)) => {
                 (self.time, self.steps, self.frames, self.knee_torque) = saved;
                 self.skeleton.restore(&skeleton);
                 if let Some(t) = &mut self.tissue {
                     if let Some(b) = tissue_backup.take() {
                         t.restore(b);
                     }
-                    if let Some(pending) = clock {
+                    if let Some((pending, _)) = clock {
                         t.pending = pending;
                     }
                 }
@@ -103,8 +129,35 @@ impl Simulation {
         };
         self.rollback = rollback;
         let advanced = self.time - saved.0;
-        self.timers.add_call(start.elapsed(), taken, advanced);
+        self.timers
+            .add_call(start.elapsed(), taken as u64, advanced);
         result
+    }
+
+    /// Muscle and skeleton steps of `h` from step `*taken` of `n` on, until the tissue
+    /// (its clock at `pending`, `period` apart; none without tissue) has an update due
+    /// (true: the caller runs it) or all `n` are taken (false). Err((when, what)) if a
+    /// step failed.
+    fn segment(
+        &mut self,
+        n: usize,
+        h: f64,
+        taken: &mut usize,
+        mut pending: Option<&mut f64>,
+        period: f64,
+    ) -> std::result::Result<bool, (f64, String)> {
+        while *taken < n {
+            *taken += 1;
+            if let Some(what) = self.substep(h).or_else(|| self.non_finite()) {
+                return Err((self.time, what));
+            }
+            if let Some(p) = pending.as_deref_mut()
+                && crate::tissue::clock_due(p, period, h)
+            {
+                return Ok(true);
+            }
+        }
+        Ok(false)
     }
 
     pub(super) fn non_finite(&self) -> Option<String> {

@@ -30,7 +30,9 @@ pub struct StepTimers {
     pub simulated_s: f64,
     /// Wall-clock time inside the calls (s).
     pub wall_s: f64,
-    /// Of `wall_s`, the part spent updating the tissue (s).
+    /// Of `wall_s`, the part spent updating the tissue (s). The muscles and the skeleton
+    /// step on beside each update's validity guard (see
+    /// [`Simulation::step`](crate::Simulation::step)), so their steps can run within it.
     pub tissue_wall_s: f64,
     /// Of `tissue_wall_s`, each phase of the updates (the rest is the backup a call
     /// takes before its first update and the check that everything stayed finite).
@@ -38,7 +40,8 @@ pub struct StepTimers {
 }
 
 impl StepTimers {
-    /// Wall-clock time spent on the muscles and the skeleton (s): all but the tissue.
+    /// Wall-clock time of the calls outside tissue updates (s): the muscles and the
+    /// skeleton, less their steps that ran beside an update's guard.
     pub fn muscles_wall_s(&self) -> f64 {
         (self.wall_s - self.tissue_wall_s).max(0.0)
     }

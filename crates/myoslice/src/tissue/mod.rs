@@ -142,6 +142,12 @@ struct TissueStatic {
     bones_crossed: OnceLock<Vec<bool>>,
 }
 
+/// What the front half of an update hands its back half (see [`Tissue::update_front`]).
+#[derive(Debug)]
+pub(crate) struct Front {
+    phases: TissuePhases,
+}
+
 /// Buffers an update fills anew each time, kept to avoid allocating them. A copy of the
 /// tissue (a checkpoint) starts with empty ones: they hold nothing between updates.
 #[derive(Debug, Default)]
@@ -375,7 +381,26 @@ impl Tissue {
         frames: &BodyFrames,
         muscles: &[MuscleUnit],
     ) -> bool {
-        self.deform(knee_angle, frames, muscles);
+        let front = self.update_front(knee_angle, frames, muscles);
+        self.update_back(front)
+    }
+
+    /// The part of an update that reads the skeleton and the muscles: everything up to
+    /// the validity guard. [`Self::update_back`] finishes it; in between, the caller may
+    /// move the skeleton and the muscles on (the back half never reads them).
+    pub(crate) fn update_front(
+        &mut self,
+        knee_angle: f64,
+        frames: &BodyFrames,
+        muscles: &[MuscleUnit],
+    ) -> Front {
+        self.deform_front(knee_angle, frames, muscles)
+    }
+
+    /// Finishes an update [`Self::update_front`] began. Returns false if anything became
+    /// non-finite (the caller puts back a [`TissueBackup`]).
+    pub(crate) fn update_back(&mut self, front: Front) -> bool {
+        self.deform_back(front);
         self.fat.x.iter().all(|p| p.is_finite())
             && self.drift.iter().all(|p| p.is_finite())
             && self
@@ -417,7 +442,12 @@ impl Tissue {
         }
     }
 
-    fn deform(&mut self, knee_angle: f64, frames: &BodyFrames, muscles: &[MuscleUnit]) {
+    fn deform_front(
+        &mut self,
+        knee_angle: f64,
+        frames: &BodyFrames,
+        muscles: &[MuscleUnit],
+    ) -> Front {
         let mut lap = Lap::start();
         let mut phases = TissuePhases::default();
         let theta = knee_angle as f32;
@@ -569,7 +599,21 @@ impl Tissue {
             pose,
         );
         self.apply_contact(&contact, gap);
+        self.theta = theta;
+        self.scratch = sc;
         phases.bone_sliding_s = lap.lap();
+        Front { phases }
+    }
+
+    /// The validity guard and the momentum carried to the next update (see
+    /// [`Self::update_back`]).
+    fn deform_back(&mut self, front: Front) {
+        // Timed from here: the back half may start a little after the front ended.
+        let mut lap = Lap::start();
+        let Front { mut phases } = front;
+        let fixed = Arc::clone(&self.fixed);
+        let mut sc = std::mem::take(&mut self.scratch);
+        let (safe, guess) = (&sc.safe, &sc.guess);
         let guarded = sc.guard.run(
             &mut self.fat,
             safe,
@@ -580,7 +624,6 @@ impl Tissue {
         for i in 0..self.drift.len() {
             self.drift[i] = self.fat.x[i] - guess[i];
         }
-        self.theta = theta;
         self.scratch = sc;
         self.metrics = LazyMetrics::updated(guarded);
         phases.guard_s = lap.lap();
@@ -618,18 +661,6 @@ impl Tissue {
         }
     }
 
-    /// Whether the tissue has an update due after `dt` more seconds.
-    pub(crate) fn advance_clock(&mut self, dt: f64) -> bool {
-        self.pending += dt;
-        if self.pending + 1e-12 >= self.period() {
-            self.pending -= self.period();
-            self.pending = self.pending.max(0.0);
-            true
-        } else {
-            false
-        }
-    }
-
     /// Fat vertices now.
     pub fn fat_vertices(&self) -> &[Vec3] {
         &self.fat.x
@@ -638,6 +669,18 @@ impl Tissue {
     /// The knee axis the tissue uses.
     pub fn knee(&self) -> &KneeAxis {
         &self.knee
+    }
+}
+
+/// Whether a tissue clock at `pending` (s since its last update) has an update due after
+/// `dt` more seconds, updates `period` apart; moves the clock on.
+pub(crate) fn clock_due(pending: &mut f64, period: f64, dt: f64) -> bool {
+    *pending += dt;
+    if *pending + 1e-12 >= period {
+        *pending = (*pending - period).max(0.0);
+        true
+    } else {
+        false
     }
 }
 
