@@ -481,8 +481,10 @@ fn a_muscle_moved_out_of_the_body_is_found_outside_the_skin() {
 fn muscles_stepping_beside_the_guard_give_the_same_bits_as_one_after_the_other() {
     // Steps and updates of exact binary fractions of a second: both runs add up the same
     // clock.
-    let mut cfg = SimulationConfig::default();
-    cfg.max_step_s = 1.0 / 1024.0;
+    let mut cfg = SimulationConfig {
+        max_step_s: 1.0 / 1024.0,
+        ..Default::default()
+    };
     cfg.tissue.rate_hz = 32.0;
     let mut beside = Simulation::phantom(cfg).unwrap();
     for m in [
