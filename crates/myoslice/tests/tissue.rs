@@ -237,6 +237,19 @@ fn visible_human_fat_never_inverts_nor_self_intersects_at_three_times_the_speed(
     tissue_never_breaks(lattice.clone(), 3.0);
 }
 
+/// The Visible Human leg's simulation with the default options (None without the data).
+fn visible_human() -> Option<Simulation> {
+    let lattice = common::vh_lattice()?;
+    Some(
+        Simulation::new(
+            lattice.clone(),
+            SimulationConfig::default(),
+            &MuscleCatalogue::default(),
+        )
+        .unwrap(),
+    )
+}
+
 /// Flexes `sim` to about 130° and back; returns how many muscle vertices lay more than
 /// 1 mm inside bone at rest, how many more at the worst update, and the deepest of any
 /// muscle deeper than at rest (m).
@@ -277,15 +290,9 @@ fn muscles_are_kept_out_of_bone_through_a_deep_flexion() {
 
 #[test]
 fn visible_human_muscles_are_kept_out_of_bone_through_a_deep_flexion() {
-    let Some(lattice) = common::vh_lattice() else {
+    let Some(sim) = visible_human() else {
         return;
     };
-    let sim = Simulation::new(
-        lattice.clone(),
-        SimulationConfig::default(),
-        &MuscleCatalogue::default(),
-    )
-    .unwrap();
     let (at_rest, added, deepest) = muscles_in_bone_through_a_deep_flexion(sim);
     assert!(
         at_rest == 0 && added < 400 && deepest < 0.012,
@@ -567,14 +574,7 @@ fn muscles_reach_out_through_the_skin_no_further_than_recorded_in_a_deep_flexion
 
 #[test]
 fn visible_human_muscles_reach_out_through_the_skin_no_further_than_recorded() {
-    let Some(lattice) = common::vh_lattice() else {
-        return;
-    };
-    let sim = Simulation::new(
-        lattice.clone(),
-        SimulationConfig::default(),
-        &MuscleCatalogue::default(),
-    )
-    .unwrap();
-    muscles_reach_out_no_further_than_recorded(sim);
+    if let Some(sim) = visible_human() {
+        muscles_reach_out_no_further_than_recorded(sim);
+    }
 }
