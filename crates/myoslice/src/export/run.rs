@@ -53,8 +53,9 @@ pub struct RunSummary {
     pub wall_time_s: f64,
     /// Simulated seconds per wall second.
     pub realtime_factor: f64,
-    /// Of the wall time, the part spent on the muscles and the skeleton inside `step`
-    /// (s). The rest is the build, the tissue and the writing of outputs.
+    /// Of the wall time, the part of `step` outside tissue updates (s): the muscles and
+    /// the skeleton, less their steps that ran beside an update's guard. The rest is the
+    /// build, the tissue and the writing of outputs.
     pub muscles_wall_time_s: f64,
     /// Of the wall time, the part spent on the tissue updates inside `step` (s); the
     /// updates for output frames are not in it.
