@@ -1,6 +1,7 @@
 //! Stepping: one call of `step` split into muscle and skeleton steps with the tissue
 //! updated at its own rate, rolled back whole if anything fails.
 
+use std::panic::AssertUnwindSafe;
 use std::time::Instant;
 
 use glam::Vec3;
@@ -73,22 +74,33 @@ impl Simulation {
             let Some(mut t) = self.tissue.take() else {
                 break;
             };
-            let t0 = Instant::now();
-            tissue_backup.get_or_insert_with(|| t.backup());
-            let (angle, when) = (self.knee_angle(), self.time);
-            let front = t.update_front(angle, &self.frames, &self.muscles);
-            let front_s = t0.elapsed();
+            let when = self.time;
             // The guard never reads the skeleton or the muscles: they step on to the next
             // update beside it (their steps are serial and the guard mostly so, so each
             // fills the other's idle core). Same results as one after the other.
-            let ((updated, back_s), next) = rayon::join(
-                || {
-                    let t1 = Instant::now();
-                    let ok = t.update_back(front);
-                    (ok, t1.elapsed())
-                },
-                || self.segment(n, h, &mut taken, pending.as_mut(), period),
-            );
+            let joined = std::panic::catch_unwind(AssertUnwindSafe(|| {
+                let t0 = Instant::now();
+                tissue_backup.get_or_insert_with(|| t.backup());
+                let front = t.update_front(self.knee_angle(), &self.frames, &self.muscles);
+                let front_s = t0.elapsed();
+                let (back, next) = rayon::join(
+                    || {
+                        let t1 = Instant::now();
+                        let ok = t.update_back(front);
+                        (ok, t1.elapsed())
+                    },
+                    || self.segment(n, h, &mut taken, pending.as_mut(), period),
+                );
+                (front_s, back, next)
+            }));
+            let (front_s, (updated, back_s), next) = match joined {
+                Ok(r) => r,
+                Err(panic) => {
+                    // The tissue goes back in place before the panic goes on.
+                    self.tissue = Some(t);
+                    std::panic::resume_unwind(panic)
+                }
+            };
             self.timers.add_tissue(front_s + back_s, &t.last_phases);
             self.tissue = Some(t);
             if !updated {

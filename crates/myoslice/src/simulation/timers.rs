@@ -32,7 +32,8 @@ pub struct StepTimers {
     pub wall_s: f64,
     /// Of `wall_s`, the part spent updating the tissue (s). The muscles and the skeleton
     /// step on beside each update's validity guard (see
-    /// [`Simulation::step`](crate::Simulation::step)), so their steps can run within it.
+    /// [`Simulation::step`](crate::Simulation::step)), so their steps can run within it
+    /// (on another thread, or on the guard's own while it waits for its parallel work).
     pub tissue_wall_s: f64,
     /// Of `tissue_wall_s`, each phase of the updates (the rest is the backup a call
     /// takes before its first update and the check that everything stayed finite).

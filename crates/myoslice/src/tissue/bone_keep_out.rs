@@ -1,5 +1,6 @@
 //! Muscle surfaces kept out of bone. A cross-section ring that a bone reaches into is
-//! shifted out whole, across its muscle until clear of the bone, rather than squashed:
+//! shifted out whole, across its muscle until clear of the bone (a ring the bone reaches
+//! into from opposite sides only as far as evens the two out), rather than squashed:
 //! a shifted ring keeps its area, so the muscle keeps its volume (squashing the vertices
 //! onto the bone took up to 61 % of a small muscle pressed between two bones). The shift
 //! stays with the ring from update to update and fades once the bone has gone.
@@ -263,7 +264,7 @@ impl BoneKeepOut {
     /// Finds the rings a bone reaches into, shifts them out (a neighbour as far as the
     /// largest of [`SPREAD`]'s shares of the rings near it, so the surface bends rather
     /// than steps) and moves their vertices in `current` with them. Returns how many of
-    /// the vertices it moved out were more than 1 mm deep, None when nothing moved.
+    /// the vertices found in bone were more than 1 mm deep, None when none was in bone.
     ///
     /// A ring moves across its muscle only (`axis` gives each ring's direction): moved
     /// along, it would slide into its neighbours and crease the surface.
@@ -317,8 +318,9 @@ impl BoneKeepOut {
         }
         // A ring that bone reaches into from opposite sides straddles it: no shift clears
         // it, and shifting it by its largest push ran away update after update (7 cm for
-        // the phantom's vastus medialis by the femur, out through the skin). It moves by
-        // the difference: its largest push less the largest against it.
+        // the phantom's vastus medialis by the femur, out through the skin). It moves half
+        // the difference between its largest push and the largest against it, which
+        // evens the two depths out (the whole difference would swap them).
         self.against.iter_mut().for_each(|a| *a = 0.0);
         for &(r, push) in &self.pushes {
             let r = r as usize;
@@ -328,7 +330,7 @@ impl BoneKeepOut {
         for (n, &a) in self.need.iter_mut().zip(&self.against) {
             if a > 0.0 {
                 let len = n.length();
-                *n *= ((len - a) / len).max(0.0);
+                *n *= (0.5 * (len - a) / len).max(0.0);
             }
         }
         let rings = self.need.len();
@@ -466,9 +468,10 @@ mod tests {
 
     #[test]
     fn a_ring_a_bone_reaches_into_from_opposite_sides_is_not_pushed_away() {
-        // A bone 20 mm wide ahead of the rings along their axis (clear of them at rest);
-        // the rings then move 12 mm along and flatten to 8 mm across in y, so the bone
-        // reaches 2 mm into each ring from both sides at once.
+        // A bone 20 mm wide from z = 5 mm on, clear of the rings at rest (their inradius,
+        // 14.9 mm, is more than its half-diagonal); the rings then move 12 mm along and
+        // flatten to a semi-axis of 8 mm in y, so the bone reaches 2 mm into each ring
+        // from both sides in y at once (and about as far in x).
         let bones = [box_bone(
             Vec3::new(-0.01, -0.01, 0.005),
             Vec3::new(0.01, 0.01, 0.05),

@@ -374,7 +374,8 @@ impl Tissue {
     }
 
     /// [`Self::update`] without its own backup: the caller puts back a [`TissueBackup`]
-    /// if this returns false (a `step` call backs up once, before its first update).
+    /// if this returns false. (`step` runs [`Self::update_front`] and
+    /// [`Self::update_back`] itself, backing up once before its first update.)
     pub(crate) fn update_unguarded(
         &mut self,
         knee_angle: f64,
