@@ -386,18 +386,6 @@ impl Tissue {
         self.update_back(front)
     }
 
-    /// The part of an update that reads the skeleton and the muscles: everything up to
-    /// the validity guard. [`Self::update_back`] finishes it; in between, the caller may
-    /// move the skeleton and the muscles on (the back half never reads them).
-    pub(crate) fn update_front(
-        &mut self,
-        knee_angle: f64,
-        frames: &BodyFrames,
-        muscles: &[MuscleUnit],
-    ) -> Front {
-        self.deform_front(knee_angle, frames, muscles)
-    }
-
     /// Finishes an update [`Self::update_front`] began. Returns false if anything became
     /// non-finite (the caller puts back a [`TissueBackup`]).
     pub(crate) fn update_back(&mut self, front: Front) -> bool {
@@ -443,7 +431,10 @@ impl Tissue {
         }
     }
 
-    fn deform_front(
+    /// The part of an update that reads the skeleton and the muscles: everything up to
+    /// the validity guard. [`Self::update_back`] finishes it; in between, the caller may
+    /// move the skeleton and the muscles on (the back half never reads them).
+    pub(crate) fn update_front(
         &mut self,
         knee_angle: f64,
         frames: &BodyFrames,
