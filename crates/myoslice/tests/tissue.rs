@@ -282,7 +282,7 @@ fn muscles_are_kept_out_of_bone_through_a_deep_flexion() {
     // Without the rings' shifts: about 2 700 more vertices, 19 mm deep; with rings that
     // straddle a bone shifted by their largest push, 14.7 mm deep.
     assert!(
-        added < 400 && deepest < 0.012,
+        added < 300 && deepest < 0.01,
         "{added} more muscle vertices than at rest > 1 mm inside bone, the deepest {:.1} mm",
         deepest * 1e3
     );
@@ -295,7 +295,7 @@ fn visible_human_muscles_are_kept_out_of_bone_through_a_deep_flexion() {
     };
     let (at_rest, added, deepest) = muscles_in_bone_through_a_deep_flexion(sim);
     assert!(
-        at_rest == 0 && added < 400 && deepest < 0.012,
+        at_rest == 0 && added < 300 && deepest < 0.01,
         "{at_rest} muscle vertices > 1 mm inside bone at rest, at most {added} more, the \
          deepest {:.1} mm",
         deepest * 1e3
@@ -529,7 +529,9 @@ fn muscles_stepping_beside_the_guard_give_the_same_bits_as_one_after_the_other()
 /// A regression bound, not a goal: the fold drags the skin behind the knee further round
 /// than the muscles under it (see the README), and the bound records how far. While the
 /// knee first bends to 45° it is tighter: rings pushed off a bone from both sides ran
-/// away (the phantom's vastus medialis came 21 mm out).
+/// away (the phantom's vastus medialis came 21 mm out). Below 70° it holds the calf's
+/// muscles on their side of the contact plane (without: 2 237 vertices on the phantom,
+/// 2 207 on the Visible Human, most on the way back).
 fn muscles_reach_out_no_further_than_recorded(mut sim: Simulation) {
     let (mut most, mut below_70, mut farthest, mut rising_45) = (0usize, 0usize, 0.0f32, 0.0f32);
     let mut top = 0.0f64;
@@ -560,7 +562,7 @@ fn muscles_reach_out_no_further_than_recorded(mut sim: Simulation) {
     );
     eprintln!("{summary}");
     assert!(
-        rising_45 < 0.012 && most < 13_000 && below_70 < 3_000 && farthest < 0.06,
+        rising_45 < 0.006 && most < 11_000 && below_70 < 1_800 && farthest < 0.06,
         "{summary}"
     );
 }

@@ -4,6 +4,11 @@
 //! a shifted ring keeps its area, so the muscle keeps its volume (squashing the vertices
 //! onto the bone took up to 61 % of a small muscle pressed between two bones). The shift
 //! stays with the ring from update to update and fades once the bone has gone.
+//!
+//! Behind the knee the same shifts keep each muscle's rings on their own side of the
+//! contact plane (thigh or calf, as each vertex lay at rest), where the calf's muscles
+//! would otherwise rise with the shank past the plane that holds the fat apart and come
+//! out through the skin of the crease; a bone wins over the plane.
 
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::BoundingVolume;
@@ -11,8 +16,8 @@ use parry3d::query::PointQueryWithLocation;
 use parry3d::shape::TriMesh;
 
 use super::bone_slide::BoneMesh;
+use super::knee_fold::Contact;
 use crate::body::BodyId;
-use crate::lattice::winding_number;
 use crate::muscle::BodyFrames;
 
 /// Muscle vertices closer than this (m) to a bone at rest are watched against it...
@@ -33,6 +38,9 @@ const PUSH_ROUNDS: usize = 8;
 /// Share of a ring's shift kept over a thirtieth of a second (one update at the default
 /// rate).
 const FADE: f32 = 0.9;
+/// Most the contact plane pushes a vertex (m) in one round: pushed as far as it wanted
+/// at once, at deep flexion the rings were driven up to 19 mm into bone.
+const PLANE_STEP_M: f32 = 0.002;
 
 /// The bones a tissue update sees: surfaces with adjacency, the same as parry meshes (for
 /// the rare global query) and the bodies' poses.
@@ -43,6 +51,8 @@ pub(crate) struct Bones<'a> {
     pub(crate) frames: &'a BodyFrames,
     /// Share of a ring's shift kept into this update (see [`fade_per_update`]).
     pub(crate) fade: f32,
+    /// The contact plane behind the knee (world), which muscles keep their side of.
+    pub(crate) contact: Option<Contact>,
 }
 
 /// Share of a ring's shift kept from one update to the next at `rate_hz` updates a second:
@@ -52,7 +62,7 @@ pub(crate) fn fade_per_update(rate_hz: f64) -> f32 {
 }
 
 impl Bones<'_> {
-    fn pose(&self, body: BodyId) -> (Quat, Vec3) {
+    pub(crate) fn pose(&self, body: BodyId) -> (Quat, Vec3) {
         match body {
             BodyId::Thigh => self.frames.thigh,
             BodyId::Shank => self.frames.shank,
@@ -126,6 +136,10 @@ pub(crate) struct BoneKeepOut {
     pairs: Vec<(u32, u32)>,
     /// What each pair knew at its last check.
     watch: Vec<Watch>,
+    /// Vertices near the knee kept on their side of the contact plane: (vertex, how far
+    /// on its side it was at rest (m, negative past it), whether the side is the
+    /// thigh's). None need keep further from the plane than at rest.
+    plane: Vec<(u32, f32, bool)>,
     /// Shift of each ring (world, m).
     pub(crate) shift: Vec<Vec3>,
     /// Work buffers: the shift each ring needs this update, and that spread to its
@@ -139,6 +153,9 @@ pub(crate) struct BoneKeepOut {
     against: Vec<f32>,
     /// What [`Self::clear_rings`] moved each ring by.
     moved: Vec<Vec3>,
+    /// Work buffer: the last shift bones alone asked of each ring this update (zero if
+    /// none; the contact plane may not push against it).
+    bone_push: Vec<Vec3>,
 }
 
 /// What a [`BoneKeepOut`] carries from one update to the next: the rings' shifts and what
@@ -174,7 +191,23 @@ impl BoneKeepOut {
         bones: &[(BodyId, TriMesh)],
         meshes: &[BoneMesh],
         knee: Vec3,
+        rest_contact: &Contact,
     ) -> Self {
+        let plane = rest
+            .iter()
+            .enumerate()
+            // Only what lies behind the knee or near the axis at rest can come past the
+            // plane: in front, the plane turns away as the knee bends.
+            .filter(|(_, p)| {
+                p.distance(knee) < KNEE_M
+                    && (**p - rest_contact.point).dot(rest_contact.behind) > -0.01
+            })
+            .map(|(v, &p)| {
+                let thigh = p.z >= knee.z;
+                let d = (p - rest_contact.point).dot(rest_contact.normal);
+                (v as u32, if thigh { d } else { -d }, thigh)
+            })
+            .collect();
         let mut pairs = Vec::new();
         let mut watch = Vec::new();
         for (b, (_, mesh)) in bones.iter().enumerate() {
@@ -211,12 +244,14 @@ impl BoneKeepOut {
         Self {
             pairs,
             watch,
+            plane,
             shift: vec![Vec3::ZERO; rings],
             need: vec![Vec3::ZERO; rings],
             spread: vec![Vec3::ZERO; rings],
             pushes: Vec::new(),
             against: vec![0.0; rings],
             moved: vec![Vec3::ZERO; rings],
+            bone_push: vec![Vec3::ZERO; rings],
         }
     }
 
@@ -230,9 +265,9 @@ impl BoneKeepOut {
         self.shift.iter_mut().for_each(|s| *s = Vec3::ZERO);
     }
 
-    /// Shifts the rings out of the bones in up to [`PUSH_ROUNDS`] rounds of
-    /// [`Self::push_out`] (a shift can move a ring's other vertices in) and returns how far
-    /// each ring moved in all.
+    /// Shifts the rings out of the bones and back toward their side of the contact plane
+    /// in up to [`PUSH_ROUNDS`] rounds of [`Self::push_out`] (a shift can move a ring's
+    /// other vertices in) and returns how far each ring moved in all.
     pub(crate) fn clear_rings(
         &mut self,
         current: &mut [Vec3],
@@ -242,6 +277,7 @@ impl BoneKeepOut {
     ) -> &[Vec3] {
         self.moved.clear();
         self.moved.resize(self.shift.len(), Vec3::ZERO);
+        self.bone_push.iter_mut().for_each(|b| *b = Vec3::ZERO);
         let mut last = usize::MAX;
         for round in 0..PUSH_ROUNDS {
             let Some(deep) = self.push_out(current, ring_of, &axis, bones, round > 0) else {
@@ -261,10 +297,47 @@ impl BoneKeepOut {
         &self.moved
     }
 
-    /// Finds the rings a bone reaches into, shifts them out (a neighbour as far as the
-    /// largest of [`SPREAD`]'s shares of the rings near it, so the surface bends rather
-    /// than steps) and moves their vertices in `current` with them. Returns how many of
-    /// the vertices found in bone were more than 1 mm deep, None when none was in bone.
+    /// Records in `pushes` and `need` a push of ring `r` (axis `a`) by `d`, the world
+    /// vector that clears what one of its vertices reaches into, and counts it in `deep`
+    /// if over 1 mm. A push across the ring that cannot clear the contact plane (`plane`:
+    /// its normal runs nearly along the muscle) is no push at all.
+    fn add_push(
+        pushes: &mut Vec<(u32, Vec3)>,
+        need: &mut [Vec3],
+        r: usize,
+        d: Vec3,
+        a: Vec3,
+        deep: &mut Option<usize>,
+        plane: bool,
+    ) {
+        let push = d + d.normalize_or_zero() * MARGIN_M;
+        // Across the ring, as far as clears the bone along its normal (at most twice
+        // the depth where the normal runs nearly along the muscle).
+        let across = push - a * push.dot(a);
+        let clears = across.dot(push);
+        let push = if clears > 0.25 * push.length_squared() {
+            across * (push.length_squared() / clears)
+        } else if plane {
+            return; // a ring across the plane at rest would be thrown sideways
+        } else {
+            across.normalize_or_zero() * (2.0 * push.length())
+        };
+        if push == Vec3::ZERO {
+            return; // the bone's normal runs along the muscle: nothing across
+        }
+        pushes.push((r as u32, push));
+        let need = &mut need[r];
+        if push.length_squared() > need.length_squared() {
+            *need = push;
+        }
+        *deep = Some(deep.unwrap_or(0) + usize::from(d.length_squared() > 1e-6));
+    }
+
+    /// Finds the rings a bone reaches into or that lie past the contact plane, shifts
+    /// them out (a neighbour as far as the largest of [`SPREAD`]'s shares of the rings
+    /// near it, so the surface bends rather than steps) and moves their vertices in
+    /// `current` with them. Returns how many of the vertices found in bone or past the
+    /// plane were more than 1 mm in, None when none was.
     ///
     /// A ring moves across its muscle only (`axis` gives each ring's direction): moved
     /// along, it would slide into its neighbours and crease the surface.
@@ -290,26 +363,30 @@ impl BoneKeepOut {
                 continue;
             };
             let r = ring_of[v as usize] as usize;
-            let push = d + d.normalize_or_zero() * MARGIN_M;
-            // Across the ring, as far as clears the bone along its normal (at most twice
-            // the depth where the normal runs nearly along the muscle).
-            let a = axis(r);
-            let across = push - a * push.dot(a);
-            let clears = across.dot(push);
-            let push = if clears > 0.25 * push.length_squared() {
-                across * (push.length_squared() / clears)
-            } else {
-                across.normalize_or_zero() * (2.0 * push.length())
-            };
-            if push == Vec3::ZERO {
-                continue; // the bone's normal runs along the muscle: nothing across
+            let (pushes, need) = (&mut self.pushes, &mut self.need);
+            Self::add_push(pushes, need, r, d, axis(r), &mut deep, false);
+        }
+        // Then the contact plane, which may not push a ring against the way a bone
+        // pushed it this update (a bone wins).
+        for (b, n) in self.bone_push.iter_mut().zip(&self.need) {
+            if *n != Vec3::ZERO {
+                *b = *n;
             }
-            self.pushes.push((r as u32, push));
-            let need = &mut self.need[r];
-            if push.length_squared() > need.length_squared() {
-                *need = push;
+        }
+        if let Some(c) = &bones.contact {
+            for &(v, rest_d, thigh) in &self.plane {
+                let r = ring_of[v as usize] as usize;
+                if again && self.spread[r] == Vec3::ZERO {
+                    continue;
+                }
+                let p = current[v as usize];
+                let d = (c.apply(p, thigh, c.muscle_margin.min(rest_d)) - p)
+                    .clamp_length_max(PLANE_STEP_M);
+                if d != Vec3::ZERO && d.dot(self.bone_push[r]) >= 0.0 {
+                    let (pushes, need) = (&mut self.pushes, &mut self.need);
+                    Self::add_push(pushes, need, r, d, axis(r), &mut deep, true);
+                }
             }
-            deep = Some(deep.unwrap_or(0) + usize::from(d.length_squared() > 1e-6));
         }
         if deep.is_none() {
             // Nothing moved: a call `again` after this one must find every ring still.
@@ -356,155 +433,6 @@ impl BoneKeepOut {
     }
 }
 
-/// How far muscle surfaces reach into bone (see [`super::Tissue::muscles_in_bone`]).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct BoneOverlap {
-    /// Muscle vertices more than 1 mm inside a bone.
-    pub vertices_over_1mm: usize,
-    /// Deepest muscle vertex inside a bone (m), 0 when none is.
-    pub deepest_m: f32,
-}
-
-/// Measures `vertices` against every bone (a tree query per vertex near a bone; exact
-/// for a surface that does not cross itself). `crossed[b]` says bone `b`'s surface
-/// crosses itself (tubes of one bone overlapping, or a tube folding): there the
-/// pseudo-normal can call a point outside inside, so the winding number confirms it;
-/// it can still miss a point inside one tube whose nearest surface is another tube's
-/// wall running inside it, and measures depth to that wall (a lower bound).
-pub(crate) fn overlap(vertices: &[Vec3], bones: &Bones, crossed: &[bool]) -> BoneOverlap {
-    let mut o = BoneOverlap::default();
-    for (b, (body, mesh)) in bones.surfaces.iter().enumerate() {
-        let (q, t) = bones.pose(*body);
-        let aabb = mesh.local_aabb();
-        for &p in vertices {
-            let p_rest = q.inverse() * (p - t);
-            if !aabb.contains_local_point(p_rest) {
-                continue;
-            }
-            let w = bones.meshes[b].walk_from_tree(mesh, p_rest);
-            let d = w.point.distance(p_rest);
-            // Only what would change the result is confirmed (a winding number visits
-            // every triangle).
-            if !w.inside || (d <= 1e-3 && d <= o.deepest_m) {
-                continue;
-            }
-            if crossed[b] && winding_number(mesh.vertices(), mesh.indices(), p_rest).abs() < 0.5 {
-                continue;
-            }
-            o.deepest_m = o.deepest_m.max(d);
-            o.vertices_over_1mm += usize::from(d > 1e-3);
-        }
-    }
-    o
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A box bone `lo..hi` (m), outward triangles.
-    fn box_bone(lo: Vec3, hi: Vec3) -> (BodyId, TriMesh) {
-        let v: Vec<Vec3> = (0..8)
-            .map(|i| {
-                Vec3::new(
-                    if i & 1 == 0 { lo.x } else { hi.x },
-                    if i & 2 == 0 { lo.y } else { hi.y },
-                    if i & 4 == 0 { lo.z } else { hi.z },
-                )
-            })
-            .collect();
-        let quads = [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
-        let t: Vec<[u32; 3]> = quads
-            .iter()
-            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-            .collect();
-        let mesh = TriMesh::new(v, t).unwrap_or_else(|e| panic!("{e}"));
-        (BodyId::Thigh, mesh)
-    }
-
-    /// Rings of 32 vertices round the z axis, `RINGS` of them 2 mm apart from z = 0, with
-    /// semi-axes `a` (x) and `b` (y), shifted along z by `dz`.
-    const RINGS: usize = 5;
-    fn rings(a: f32, b: f32, dz: f32) -> (Vec<Vec3>, Vec<u32>) {
-        let mut p = Vec::new();
-        let mut ring_of = Vec::new();
-        for r in 0..RINGS {
-            for k in 0..32 {
-                let t = k as f32 / 32.0 * std::f32::consts::TAU;
-                p.push(Vec3::new(a * t.cos(), b * t.sin(), dz + 0.002 * r as f32));
-                ring_of.push(r as u32);
-            }
-        }
-        (p, ring_of)
-    }
-
-    /// Runs `updates` updates as a muscle shape does: the rings placed at `base` plus
-    /// their faded shifts, then pushed out round after round. Returns the largest shift.
-    fn run(
-        keep: &mut BoneKeepOut,
-        base: &[Vec3],
-        ring_of: &[u32],
-        bones: &Bones,
-        updates: usize,
-    ) -> f32 {
-        for _ in 0..updates {
-            keep.fade(bones.fade);
-            let mut current: Vec<Vec3> = base
-                .iter()
-                .zip(ring_of)
-                .map(|(p, &r)| *p + keep.shift[r as usize])
-                .collect();
-            keep.clear_rings(&mut current, ring_of, |_| Vec3::Z, bones);
-        }
-        keep.shift.iter().map(|s| s.length()).fold(0.0, f32::max)
-    }
-
-    #[test]
-    fn a_ring_a_bone_reaches_into_from_opposite_sides_is_not_pushed_away() {
-        // A bone 20 mm wide from z = 5 mm on, clear of the rings at rest (their inradius,
-        // 14.9 mm, is more than its half-diagonal); the rings then move 12 mm along and
-        // flatten to a semi-axis of 8 mm in y, so the bone reaches 2 mm into each ring
-        // from both sides in y at once (and about as far in x).
-        let bones = [box_bone(
-            Vec3::new(-0.01, -0.01, 0.005),
-            Vec3::new(0.01, 0.01, 0.05),
-        )];
-        let meshes = [BoneMesh::new(bones[0].0, &bones[0].1)];
-        let frames = BodyFrames::REST;
-        let b = Bones {
-            meshes: &meshes,
-            surfaces: &bones,
-            frames: &frames,
-            fade: fade_per_update(30.0),
-        };
-        let (rest, ring_of) = rings(0.015, 0.015, 0.0);
-        let mut keep = BoneKeepOut::new(&rest, RINGS, &bones, &meshes, Vec3::splat(10.0));
-        assert!(!keep.pairs.is_empty(), "no vertex watched");
-        let (flat, _) = rings(0.015, 0.008, 0.012);
-        let far = run(&mut keep, &flat, &ring_of, &b, 30);
-        assert!(far < 1e-4, "a straddling ring moved {:.1} mm", far * 1e3);
-        // Reached from one side only (the flat rings 15 mm up in y, their lowest vertices
-        // 3 mm into the bone), they are pushed clear on that side.
-        let one_sided: Vec<Vec3> = flat
-            .iter()
-            .map(|p| *p + Vec3::new(0.0, 0.015, 0.0))
-            .collect();
-        let mut keep = BoneKeepOut::new(&rest, RINGS, &bones, &meshes, Vec3::splat(10.0));
-        let moved = run(&mut keep, &one_sided, &ring_of, &b, 1);
-        assert!(
-            moved > 0.003,
-            "a ring reached from one side moved {:.1} mm",
-            moved * 1e3
-        );
-        for r in 0..RINGS {
-            assert!(keep.shift[r].y > 0.0, "ring {r}: {:?}", keep.shift[r]);
-        }
-    }
-}
+#[path = "bone_keep_out_tests.rs"]
+mod tests;

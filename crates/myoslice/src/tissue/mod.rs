@@ -3,6 +3,7 @@
 //! validity guard, and the per-element metrics of the paper (section 5.3).
 
 mod bone_keep_out;
+mod bone_overlap;
 mod bone_slide;
 mod fat_lanes;
 pub mod fat_solver;
@@ -37,8 +38,8 @@ use crate::body::{BodyId, KneeAxis, body_of_bone};
 use crate::error::{Result, check_range};
 use crate::lattice::{InnerContact, Lattice};
 use crate::muscle::{BodyFrames, MuscleUnit};
-pub use bone_keep_out::BoneOverlap;
 use bone_keep_out::{Bones, KeepOutMemory};
+pub use bone_overlap::BoneOverlap;
 use bone_slide::{BoneMesh, BoneSlide};
 use guard::Guard;
 
@@ -137,7 +138,7 @@ struct TissueStatic {
     outer_faces: Vec<(u32, [u32; 4], f64)>,
     /// The skin closed at both ends (for [`Tissue::muscles_outside_skin`]).
     skin: ClosedSkin,
-    /// Whether each bone's surface crosses itself (see [`bone_keep_out::overlap`]),
+    /// Whether each bone's surface crosses itself (see [`bone_overlap::overlap`]),
     /// found when first needed.
     bones_crossed: OnceLock<Vec<bool>>,
 }
@@ -220,11 +221,12 @@ impl Tissue {
     ) -> Result<Self> {
         config.validate()?;
         let bone_meshes: Vec<BoneMesh> = bones.iter().map(|(b, m)| BoneMesh::new(*b, m)).collect();
+        let rest_contact = KneeFold::new(&knee, 0.0).contact(0.0);
         let shapes: Vec<MuscleShape> = muscles
             .par_iter()
             .map(|m| {
                 let mut s = MuscleShape::new(&lattice.muscles[m.lattice_index], &m.chain);
-                s.watch_bones(&bones, &bone_meshes, knee.point);
+                s.watch_bones(&bones, &bone_meshes, knee.point, &rest_contact);
                 s
             })
             .collect();
@@ -335,6 +337,7 @@ impl Tissue {
             surfaces: &self.fixed.bones,
             frames,
             fade: 1.0,
+            contact: None,
         };
         let crossed = self.fixed.bones_crossed.get_or_init(|| {
             self.fixed
@@ -345,7 +348,7 @@ impl Tissue {
         });
         self.muscles
             .par_iter()
-            .map(|m| bone_keep_out::overlap(&m.current, &bones, crossed))
+            .map(|m| bone_overlap::overlap(&m.current, &bones, crossed))
             .collect()
     }
 
@@ -455,14 +458,16 @@ impl Tissue {
             behind: tq * contact.behind,
             ..contact
         };
-        // Muscles are not pushed by the contact plane: their volume is the invariant
-        // kept; the fat over them is. Bones push them aside, ring by ring.
+        // Muscles are not squashed onto the contact plane (their volume is the invariant
+        // kept; the fat over them is): bones push them aside ring by ring, and the plane
+        // pushes whole rings back to their side of it, a little each round.
         let fixed = Arc::clone(&self.fixed);
         let bones = Bones {
             meshes: &fixed.bone_meshes,
             surfaces: &fixed.bones,
             frames,
             fade: bone_keep_out::fade_per_update(self.config.rate_hz),
+            contact: Some(contact),
         };
         self.muscles
             .par_iter_mut()

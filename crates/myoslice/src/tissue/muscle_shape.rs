@@ -120,8 +120,16 @@ impl MuscleShape {
         bones: &[(crate::body::BodyId, parry3d::shape::TriMesh)],
         meshes: &[super::bone_slide::BoneMesh],
         knee: Vec3,
+        rest_contact: &Contact,
     ) {
-        self.keep = BoneKeepOut::new(&self.rest, self.ring_param.len(), bones, meshes, knee);
+        self.keep = BoneKeepOut::new(
+            &self.rest,
+            self.ring_param.len(),
+            bones,
+            meshes,
+            knee,
+            rest_contact,
+        );
     }
 
     /// Places every vertex on the chain's current shape. Where the knee fold rules (see

@@ -1,0 +1,194 @@
+//! Tests of the keep-out from bone and the contact plane ([`super::BoneKeepOut`]).
+
+use super::*;
+
+/// A contact plane far from the test's rings.
+fn far_contact() -> Contact {
+    Contact {
+        point: Vec3::splat(10.0),
+        normal: Vec3::Z,
+        behind: Vec3::Y,
+        muscle_margin: 0.0,
+    }
+}
+
+/// A box bone `lo..hi` (m), outward triangles.
+fn box_bone(lo: Vec3, hi: Vec3) -> (BodyId, TriMesh) {
+    let v: Vec<Vec3> = (0..8)
+        .map(|i| {
+            Vec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+        .collect();
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let t: Vec<[u32; 3]> = quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect();
+    let mesh = TriMesh::new(v, t).unwrap_or_else(|e| panic!("{e}"));
+    (BodyId::Thigh, mesh)
+}
+
+/// Rings of 32 vertices round the z axis, `RINGS` of them 2 mm apart from z = 0, with
+/// semi-axes `a` (x) and `b` (y), shifted along z by `dz`.
+const RINGS: usize = 5;
+fn rings(a: f32, b: f32, dz: f32) -> (Vec<Vec3>, Vec<u32>) {
+    let mut p = Vec::new();
+    let mut ring_of = Vec::new();
+    for r in 0..RINGS {
+        for k in 0..32 {
+            let t = k as f32 / 32.0 * std::f32::consts::TAU;
+            p.push(Vec3::new(a * t.cos(), b * t.sin(), dz + 0.002 * r as f32));
+            ring_of.push(r as u32);
+        }
+    }
+    (p, ring_of)
+}
+
+/// Runs `updates` updates as a muscle shape does: the rings placed at `base` plus
+/// their faded shifts, then pushed out round after round. Returns the largest shift.
+fn run(
+    keep: &mut BoneKeepOut,
+    base: &[Vec3],
+    ring_of: &[u32],
+    bones: &Bones,
+    updates: usize,
+) -> f32 {
+    for _ in 0..updates {
+        keep.fade(bones.fade);
+        let mut current: Vec<Vec3> = base
+            .iter()
+            .zip(ring_of)
+            .map(|(p, &r)| *p + keep.shift[r as usize])
+            .collect();
+        keep.clear_rings(&mut current, ring_of, |_| Vec3::Z, bones);
+    }
+    keep.shift.iter().map(|s| s.length()).fold(0.0, f32::max)
+}
+
+#[test]
+fn a_ring_a_bone_reaches_into_from_opposite_sides_is_not_pushed_away() {
+    // A bone 20 mm wide from z = 5 mm on, clear of the rings at rest (their inradius,
+    // 14.9 mm, is more than its half-diagonal); the rings then move 12 mm along and
+    // flatten to a semi-axis of 8 mm in y, so the bone reaches 2 mm into each ring
+    // from both sides in y at once (and about as far in x).
+    let bones = [box_bone(
+        Vec3::new(-0.01, -0.01, 0.005),
+        Vec3::new(0.01, 0.01, 0.05),
+    )];
+    let meshes = [BoneMesh::new(bones[0].0, &bones[0].1)];
+    let frames = BodyFrames::REST;
+    let b = Bones {
+        meshes: &meshes,
+        surfaces: &bones,
+        frames: &frames,
+        fade: fade_per_update(30.0),
+        contact: None,
+    };
+    let (rest, ring_of) = rings(0.015, 0.015, 0.0);
+    let mut keep = BoneKeepOut::new(
+        &rest,
+        RINGS,
+        &bones,
+        &meshes,
+        Vec3::splat(10.0),
+        &far_contact(),
+    );
+    assert!(!keep.pairs.is_empty(), "no vertex watched");
+    let (flat, _) = rings(0.015, 0.008, 0.012);
+    let far = run(&mut keep, &flat, &ring_of, &b, 30);
+    assert!(far < 1e-4, "a straddling ring moved {:.1} mm", far * 1e3);
+    // Reached from one side only (the flat rings 15 mm up in y, their lowest vertices
+    // 3 mm into the bone), they are pushed clear on that side.
+    let one_sided: Vec<Vec3> = flat
+        .iter()
+        .map(|p| *p + Vec3::new(0.0, 0.015, 0.0))
+        .collect();
+    let mut keep = BoneKeepOut::new(
+        &rest,
+        RINGS,
+        &bones,
+        &meshes,
+        Vec3::splat(10.0),
+        &far_contact(),
+    );
+    let moved = run(&mut keep, &one_sided, &ring_of, &b, 1);
+    assert!(
+        moved > 0.003,
+        "a ring reached from one side moved {:.1} mm",
+        moved * 1e3
+    );
+    for r in 0..RINGS {
+        assert!(keep.shift[r].y > 0.0, "ring {r}: {:?}", keep.shift[r]);
+    }
+}
+
+#[test]
+fn rings_past_the_contact_plane_go_back_to_their_side_and_rings_across_it_at_rest_stay() {
+    // No bone; the knee at the origin, the rest plane level (z up, behind +y).
+    let frames = BodyFrames::REST;
+    let rest_plane = Contact {
+        point: Vec3::ZERO,
+        normal: Vec3::Z,
+        behind: Vec3::Y,
+        muscle_margin: 0.001,
+    };
+    let bones = |contact| Bones {
+        meshes: &[],
+        surfaces: &[],
+        frames: &frames,
+        fade: fade_per_update(30.0),
+        contact: Some(contact),
+    };
+    // Thigh-side rings (z 10–18 mm) of radius 10 mm round y = 4 mm; the plane turned
+    // 45° into the thigh behind the knee reaches 2.8 mm past their back.
+    let (rest, ring_of) = rings(0.01, 0.01, 0.01);
+    let rest: Vec<Vec3> = rest.iter().map(|p| *p + Vec3::Y * 0.004).collect();
+    let turned = Contact {
+        normal: Vec3::new(0.0, -1.0, 1.0).normalize(),
+        behind: Vec3::new(0.0, 1.0, 1.0).normalize(),
+        ..rest_plane
+    };
+    let past = |keep: &BoneKeepOut| {
+        rest.iter()
+            .zip(&ring_of)
+            .map(|(p, &r)| *p + keep.shift[r as usize])
+            .filter(|p| p.dot(turned.behind) > 0.0)
+            .map(|p| -p.dot(turned.normal))
+            .fold(0.0f32, f32::max)
+    };
+    let mut keep = BoneKeepOut::new(&rest, RINGS, &[], &[], Vec3::ZERO, &rest_plane);
+    assert!(
+        past(&keep) > 0.0025,
+        "the rings start {:.1} mm past",
+        past(&keep) * 1e3
+    );
+    run(&mut keep, &rest, &ring_of, &bones(turned), 20);
+    assert!(
+        past(&keep) <= 0.0,
+        "{:.1} mm past the plane",
+        past(&keep) * 1e3
+    );
+    for s in &keep.shift {
+        // Across the rings (their axis is z), toward the thigh's side.
+        assert!(s.z == 0.0 && s.y < 0.0, "{s:?}");
+    }
+    assert!(keep.shift[0].y < -0.002, "{:?}", keep.shift[0]);
+    // Rings across the knee's level (z −4 to 4 mm) and across a rest plane tilted
+    // 45°, whose thigh-side vertices lie up to 7 mm past it: each vertex may stay
+    // as near the plane, or as far past it, as at rest, so nothing moves.
+    let (rest, ring_of) = rings(0.01, 0.01, -0.004);
+    let mut keep = BoneKeepOut::new(&rest, RINGS, &[], &[], Vec3::ZERO, &turned);
+    let moved = run(&mut keep, &rest, &ring_of, &bones(turned), 20);
+    assert!(moved == 0.0, "moved {:.1} mm", moved * 1e3);
+}
