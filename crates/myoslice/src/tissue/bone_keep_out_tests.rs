@@ -96,14 +96,17 @@ fn a_ring_a_bone_reaches_into_from_opposite_sides_is_not_pushed_away() {
         contact: None,
     };
     let (rest, ring_of) = rings(0.015, 0.015, 0.0);
-    let mut keep = BoneKeepOut::new(
-        &rest,
-        RINGS,
-        &bones,
-        &meshes,
-        Vec3::splat(10.0),
-        &far_contact(),
-    );
+    let fresh = || {
+        BoneKeepOut::new(
+            &rest,
+            RINGS,
+            &bones,
+            &meshes,
+            Vec3::splat(10.0),
+            &far_contact(),
+        )
+    };
+    let mut keep = fresh();
     assert!(!keep.pairs.is_empty(), "no vertex watched");
     let (flat, _) = rings(0.015, 0.008, 0.012);
     let far = run(&mut keep, &flat, &ring_of, &b, 30);
@@ -114,14 +117,7 @@ fn a_ring_a_bone_reaches_into_from_opposite_sides_is_not_pushed_away() {
         .iter()
         .map(|p| *p + Vec3::new(0.0, 0.015, 0.0))
         .collect();
-    let mut keep = BoneKeepOut::new(
-        &rest,
-        RINGS,
-        &bones,
-        &meshes,
-        Vec3::splat(10.0),
-        &far_contact(),
-    );
+    let mut keep = fresh();
     let moved = run(&mut keep, &one_sided, &ring_of, &b, 1);
     assert!(
         moved > 0.003,
