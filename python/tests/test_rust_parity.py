@@ -178,11 +178,13 @@ def python_timing(steps: int, dt: float, excite: dict[str, float], cwd: Path) ->
 
 # Across two processes the very same Rust steps differ by more than the binding costs: best
 # of 9 against best of 9, the Rust steps inside a Python process ran 2-8 % slower than in the
-# CLI on this machine (heap and code layout, not the binding), single pairs up to 19 %. So the
-# 5 % bound is held where it measures the binding alone (the same process, the same machine
-# code); the CLI bound only catches a wheel built wrong (a debug wheel is ten times slower).
+# CLI on this machine (heap and code layout, not the binding), single pairs up to 19 %, and
+# once (2026-12-03) 15.4 % best against best, which failed the 1.15 bound this had then. So
+# the 5 % bound is held where it measures the binding alone (the same process, the same
+# machine code); the CLI bound only catches a wheel built wrong (a debug wheel is ten times
+# slower).
 BINDING_BOUND = 1.05
-CLI_BOUND = 1.15
+CLI_BOUND = 1.5
 # A call from a Python loop may cost this much more than its Rust step (measured: under 1 us).
 CALL_OVERHEAD_BOUND_US = 5.0
 
