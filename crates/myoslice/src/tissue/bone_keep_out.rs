@@ -24,7 +24,9 @@ use crate::muscle::BodyFrames;
 const NEAR_M: f32 = 0.02;
 /// ...and within [`KNEE_M`] of the knee, where the bones turn past each other, this.
 const NEAR_KNEE_M: f32 = 0.06;
-/// Distance (m) from the knee point within which [`NEAR_KNEE_M`] holds.
+/// Distance (m) from the knee point within which [`NEAR_KNEE_M`] holds, and within which
+/// vertices are kept on their side of the contact plane (measured from the point, not the
+/// axis: it reaches less far from the axis at the sides of the knee).
 const KNEE_M: f32 = 0.12;
 /// Beyond this distance (m) from the bone a vertex's clear ball is renewed from the tree.
 const TREE_REFRESH_M: f32 = 0.004;
@@ -38,8 +40,9 @@ const PUSH_ROUNDS: usize = 8;
 /// Share of a ring's shift kept over a thirtieth of a second (one update at the default
 /// rate).
 const FADE: f32 = 0.9;
-/// Most the contact plane pushes a vertex (m) in one round: pushed as far as it wanted
-/// at once, at deep flexion the rings were driven up to 19 mm into bone.
+/// Most the contact plane asks of a vertex (m) in one round (its ring moves across the
+/// muscle up to twice that): asked as far as it wanted at once, at deep flexion the
+/// rings were driven up to 19 mm into bone.
 const PLANE_STEP_M: f32 = 0.002;
 
 /// The bones a tissue update sees: surfaces with adjacency, the same as parry meshes (for
@@ -129,7 +132,8 @@ struct Watch {
     clear: f32,
 }
 
-/// Which muscle vertices are watched against which bone, and each ring's shift.
+/// Which muscle vertices are watched against which bone and against the contact plane,
+/// and each ring's shift.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct BoneKeepOut {
     /// (muscle vertex, bone index) pairs near enough at rest to meet.
@@ -184,7 +188,9 @@ impl BoneKeepOut {
     /// Pairs every vertex of `rest` with each bone within [`NEAR_M`] of it
     /// ([`NEAR_KNEE_M`] near the knee point `knee`). A vertex already inside a bone at
     /// rest (where the slices let muscle and bone overlap) is left alone: no shift of a
-    /// ring wrapped round a bone frees it.
+    /// ring wrapped round a bone frees it. Lists the vertices kept on their side of the
+    /// contact plane, with how far from `rest_contact` (the plane at rest, rest frame;
+    /// its margin is not used) each lay.
     pub(crate) fn new(
         rest: &[Vec3],
         rings: usize,
@@ -298,9 +304,10 @@ impl BoneKeepOut {
     }
 
     /// Records in `pushes` and `need` a push of ring `r` (axis `a`) by `d`, the world
-    /// vector that clears what one of its vertices reaches into, and counts it in `deep`
-    /// if over 1 mm. A push across the ring that cannot clear the contact plane (`plane`:
-    /// its normal runs nearly along the muscle) is no push at all.
+    /// vector that clears what one of its vertices reaches into (with [`MARGIN_M`] more
+    /// for a bone), and counts it in `deep` if over 1 mm. The ring moves across its axis
+    /// as far as clears along `d`, at most twice `d`. For the contact plane (`plane`) a
+    /// push within 30° of the axis is no push at all.
     fn add_push(
         pushes: &mut Vec<(u32, Vec3)>,
         need: &mut [Vec3],
@@ -310,20 +317,27 @@ impl BoneKeepOut {
         deep: &mut Option<usize>,
         plane: bool,
     ) {
-        let push = d + d.normalize_or_zero() * MARGIN_M;
-        // Across the ring, as far as clears the bone along its normal (at most twice
-        // the depth where the normal runs nearly along the muscle).
+        // The plane's allowance already holds the muscles' margin from it.
+        let push = if plane {
+            d
+        } else {
+            d + d.normalize_or_zero() * MARGIN_M
+        };
+        // Across the ring, as far as clears along the push (at most twice its length
+        // where the push runs nearly along the muscle).
         let across = push - a * push.dot(a);
         let clears = across.dot(push);
         let push = if clears > 0.25 * push.length_squared() {
             across * (push.length_squared() / clears)
         } else if plane {
-            return; // a ring across the plane at rest would be thrown sideways
+            // Twice the push sideways would not clear the plane, only throw the ring
+            // aside (as at small angles, the plane nearly across the muscle).
+            return;
         } else {
             across.normalize_or_zero() * (2.0 * push.length())
         };
         if push == Vec3::ZERO {
-            return; // the bone's normal runs along the muscle: nothing across
+            return; // the push runs along the muscle: nothing across
         }
         pushes.push((r as u32, push));
         let need = &mut need[r];

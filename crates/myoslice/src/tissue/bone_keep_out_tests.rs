@@ -179,12 +179,34 @@ fn rings_past_the_contact_plane_go_back_to_their_side_and_rings_across_it_at_res
         // Across the rings (their axis is z), toward the thigh's side.
         assert!(s.z == 0.0 && s.y < 0.0, "{s:?}");
     }
-    assert!(keep.shift[0].y < -0.002, "{:?}", keep.shift[0]);
+    // About 2.8 mm past, and the plane's 1 mm margin, along its normal 45° off the
+    // rings' axis: some 5.4 mm across, no more.
+    let far = keep.shift[0].length();
+    assert!(
+        keep.shift[0].y < -0.002 && far < 0.008,
+        "{:?}",
+        keep.shift[0]
+    );
     // Rings across the knee's level (z −4 to 4 mm) and across a rest plane tilted
     // 45°, whose thigh-side vertices lie up to 7 mm past it: each vertex may stay
     // as near the plane, or as far past it, as at rest, so nothing moves.
     let (rest, ring_of) = rings(0.01, 0.01, -0.004);
     let mut keep = BoneKeepOut::new(&rest, RINGS, &[], &[], Vec3::ZERO, &turned);
     let moved = run(&mut keep, &rest, &ring_of, &bones(turned), 20);
+    assert!(moved == 0.0, "moved {:.1} mm", moved * 1e3);
+    // A plane turned only 20° from the rings' axis reaches up to 7.7 mm past the backs
+    // of rings round y = 40 mm, but no shift across them clears it without throwing
+    // them aside: nothing moves.
+    let (rest, ring_of) = rings(0.01, 0.01, 0.01);
+    let rest: Vec<Vec3> = rest.iter().map(|p| *p + Vec3::Y * 0.04).collect();
+    let (sin, cos) = 20f32.to_radians().sin_cos();
+    let steep = Contact {
+        normal: Vec3::new(0.0, -sin, cos),
+        behind: Vec3::new(0.0, cos, sin),
+        ..rest_plane
+    };
+    assert!(rest.iter().any(|p| p.dot(steep.normal) < -0.007));
+    let mut keep = BoneKeepOut::new(&rest, RINGS, &[], &[], Vec3::ZERO, &rest_plane);
+    let moved = run(&mut keep, &rest, &ring_of, &bones(steep), 20);
     assert!(moved == 0.0, "moved {:.1} mm", moved * 1e3);
 }

@@ -39,7 +39,7 @@ pub struct MuscleShape {
     pub volume_now: f64,
     /// Surface triangles (from the lattice).
     pub triangles: Vec<[u32; 3]>,
-    /// The rings' shifts out of bone.
+    /// The rings' shifts out of bone and back to their side of the contact plane.
     pub(crate) keep: BoneKeepOut,
 }
 
@@ -114,7 +114,8 @@ impl MuscleShape {
     }
 
     /// Watches the vertices near `bones` at rest (more of them near the knee point
-    /// `knee`), to keep them out of those bones.
+    /// `knee`), to keep them out of those bones, and those behind the knee, to keep them
+    /// on their side of the contact plane (`rest_contact`: the plane at rest).
     pub(crate) fn watch_bones(
         &mut self,
         bones: &[(crate::body::BodyId, parry3d::shape::TriMesh)],
@@ -142,7 +143,8 @@ impl MuscleShape {
         self.place(chain, knee, contact, None);
     }
 
-    /// [`Self::update`], with the rings shifted out of the bones where they reach in.
+    /// [`Self::update`], with the rings shifted out of the bones where they reach in, and
+    /// back toward their side of `bones`' contact plane.
     pub(crate) fn update_clear_of(&mut self, chain: &MuscleChain, knee: &KneeFold, bones: &Bones) {
         self.place(chain, knee, None, Some(bones));
     }
@@ -180,8 +182,8 @@ impl MuscleShape {
         };
         // Per ring: centre, turn (as a matrix: one per ring, not per vertex) and stretch
         // (all its vertices share them).
-        // Shifts out of bone only where bones are watched; kept across the muscle (the
-        // rings turn with it while a shift is world-fixed).
+        // Shifts (out of bone, off the contact plane) only where bones are watched; kept
+        // across the muscle (the rings turn with it while a shift is world-fixed).
         let shift: &[Vec3] = match bones {
             Some(b) => {
                 self.keep.fade(b.fade);
