@@ -186,19 +186,19 @@ impl BoneKeepOut {
     }
 
     /// Pairs every vertex of `rest` with each bone within [`NEAR_M`] of it
-    /// ([`NEAR_KNEE_M`] near the knee point `knee`). A vertex already inside a bone at
-    /// rest (where the slices let muscle and bone overlap) is left alone: no shift of a
-    /// ring wrapped round a bone frees it. Lists the vertices kept on their side of the
-    /// contact plane, with how far from `rest_contact` (the plane at rest, rest frame;
-    /// its margin is not used) each lay.
+    /// ([`NEAR_KNEE_M`] near the knee point, the point of `rest_contact`). A vertex
+    /// already inside a bone at rest (where the slices let muscle and bone overlap) is
+    /// left alone: no shift of a ring wrapped round a bone frees it. Lists the vertices
+    /// kept on their side of the contact plane, with how far from `rest_contact` (the
+    /// plane at rest, rest frame; its margin is not used) each lay.
     pub(crate) fn new(
         rest: &[Vec3],
         rings: usize,
         bones: &[(BodyId, TriMesh)],
         meshes: &[BoneMesh],
-        knee: Vec3,
         rest_contact: &Contact,
     ) -> Self {
+        let knee = rest_contact.point;
         let plane = rest
             .iter()
             .enumerate()

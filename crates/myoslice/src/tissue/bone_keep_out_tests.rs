@@ -2,7 +2,7 @@
 
 use super::*;
 
-/// A contact plane far from the test's rings.
+/// A contact plane, and so a knee point, far from the test's rings.
 fn far_contact() -> Contact {
     Contact {
         point: Vec3::splat(10.0),
@@ -96,16 +96,7 @@ fn a_ring_a_bone_reaches_into_from_opposite_sides_is_not_pushed_away() {
         contact: None,
     };
     let (rest, ring_of) = rings(0.015, 0.015, 0.0);
-    let fresh = || {
-        BoneKeepOut::new(
-            &rest,
-            RINGS,
-            &bones,
-            &meshes,
-            Vec3::splat(10.0),
-            &far_contact(),
-        )
-    };
+    let fresh = || BoneKeepOut::new(&rest, RINGS, &bones, &meshes, &far_contact());
     let mut keep = fresh();
     assert!(!keep.pairs.is_empty(), "no vertex watched");
     let (flat, _) = rings(0.015, 0.008, 0.012);
@@ -163,7 +154,7 @@ fn rings_past_the_contact_plane_go_back_to_their_side_and_rings_across_it_at_res
             .map(|p| -p.dot(turned.normal))
             .fold(0.0f32, f32::max)
     };
-    let mut keep = BoneKeepOut::new(&rest, RINGS, &[], &[], Vec3::ZERO, &rest_plane);
+    let mut keep = BoneKeepOut::new(&rest, RINGS, &[], &[], &rest_plane);
     assert!(
         past(&keep) > 0.0025,
         "the rings start {:.1} mm past",
@@ -191,7 +182,7 @@ fn rings_past_the_contact_plane_go_back_to_their_side_and_rings_across_it_at_res
     // 45°, whose thigh-side vertices lie up to 7 mm past it: each vertex may stay
     // as near the plane, or as far past it, as at rest, so nothing moves.
     let (rest, ring_of) = rings(0.01, 0.01, -0.004);
-    let mut keep = BoneKeepOut::new(&rest, RINGS, &[], &[], Vec3::ZERO, &turned);
+    let mut keep = BoneKeepOut::new(&rest, RINGS, &[], &[], &turned);
     let moved = run(&mut keep, &rest, &ring_of, &bones(turned), 20);
     assert!(moved == 0.0, "moved {:.1} mm", moved * 1e3);
     // A plane turned only 20° from the rings' axis reaches up to 7.7 mm past the backs
@@ -206,7 +197,7 @@ fn rings_past_the_contact_plane_go_back_to_their_side_and_rings_across_it_at_res
         ..rest_plane
     };
     assert!(rest.iter().any(|p| p.dot(steep.normal) < -0.007));
-    let mut keep = BoneKeepOut::new(&rest, RINGS, &[], &[], Vec3::ZERO, &rest_plane);
+    let mut keep = BoneKeepOut::new(&rest, RINGS, &[], &[], &rest_plane);
     let moved = run(&mut keep, &rest, &ring_of, &bones(steep), 20);
     assert!(moved == 0.0, "moved {:.1} mm", moved * 1e3);
 }

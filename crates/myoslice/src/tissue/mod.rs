@@ -170,7 +170,7 @@ impl Tissue {
             .par_iter()
             .map(|m| {
                 let mut s = MuscleShape::new(&lattice.muscles[m.lattice_index], &m.chain);
-                s.watch_bones(&bones, &bone_meshes, knee.point, &rest_contact);
+                s.watch_bones(&bones, &bone_meshes, &rest_contact);
                 s
             })
             .collect();

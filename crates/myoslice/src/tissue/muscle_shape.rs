@@ -113,14 +113,13 @@ impl MuscleShape {
         }
     }
 
-    /// Watches the vertices near `bones` at rest (more of them near the knee point
-    /// `knee`), to keep them out of those bones, and those behind the knee, to keep them
-    /// on their side of the contact plane (`rest_contact`: the plane at rest).
+    /// Watches the vertices near `bones` at rest (more of them near the knee, the point
+    /// of `rest_contact`), to keep them out of those bones, and those behind the knee, to
+    /// keep them on their side of the contact plane (`rest_contact`: the plane at rest).
     pub(crate) fn watch_bones(
         &mut self,
         bones: &[(crate::body::BodyId, parry3d::shape::TriMesh)],
         meshes: &[super::bone_slide::BoneMesh],
-        knee: Vec3,
         rest_contact: &Contact,
     ) {
         self.keep = BoneKeepOut::new(
@@ -128,7 +127,6 @@ impl MuscleShape {
             self.ring_param.len(),
             bones,
             meshes,
-            knee,
             rest_contact,
         );
     }
