@@ -33,6 +33,9 @@ pub struct ConeAnchor {
     pub axis: Vec3,
     /// Smallest and largest distance (m) from the apex.
     pub depth: [f32; 2],
+    /// The point's place at rest (body rest frame), where an unloaded chain's tether pulls
+    /// it back to (see [`super::ChainLoad::tether`]).
+    pub rest: Vec3,
 }
 
 /// How far (share of the rest depth, at least [`DEPTH_SLACK_MIN`]) a cone-anchored point
@@ -52,6 +55,7 @@ impl ConeAnchor {
             apex,
             axis,
             depth: [0.0, d + slack],
+            rest: point,
         }
     }
 }
@@ -72,7 +76,7 @@ impl BodyFrames {
         shank: (Quat::IDENTITY, Vec3::ZERO),
     };
 
-    fn of(&self, b: BodyId) -> (Quat, Vec3) {
+    pub(crate) fn of(&self, b: BodyId) -> (Quat, Vec3) {
         match b {
             BodyId::Thigh => self.thigh,
             BodyId::Shank => self.shank,
@@ -206,6 +210,17 @@ impl Clone for MuscleChain {
 }
 
 impl MuscleChain {
+    /// Takes `x` (world, at `frames`) as where each cone-anchored point rests on its
+    /// bone ([`ConeAnchor::rest`], where the tether pulls it back to).
+    pub fn set_rest_places(&mut self, x: &[Vec3], frames: &BodyFrames) {
+        for (p, c) in x.iter().zip(&mut self.cones) {
+            if let Some(c) = c {
+                let (q, t) = frames.of(c.body);
+                c.rest = q.inverse() * (*p - t);
+            }
+        }
+    }
+
     /// Number of points.
     pub fn len(&self) -> usize {
         self.x.len()

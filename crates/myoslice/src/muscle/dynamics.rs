@@ -3,6 +3,7 @@
 
 use glam::{Mat3, Vec3};
 
+use super::Tether;
 use super::chain::{BodyFrames, MuscleChain, SegmentGeom, clamp_depth, project_into_cone};
 use crate::body::BodyId;
 
@@ -14,6 +15,8 @@ pub struct ChainScratch {
     c: Vec<f32>,
     d: Vec<Vec3>,
     dv: Vec<Vec3>,
+    /// Tether stiffness of each point (N/m, 0 for none).
+    kt: Vec<f32>,
 }
 
 impl ChainScratch {
@@ -22,7 +25,7 @@ impl ChainScratch {
         if self.f.len() == n {
             return;
         }
-        for v in [&mut self.kseg, &mut self.c] {
+        for v in [&mut self.kseg, &mut self.c, &mut self.kt] {
             v.resize(n, 0.0);
         }
         for v in [&mut self.f, &mut self.d, &mut self.dv] {
@@ -52,7 +55,12 @@ pub struct ChainLoad {
     pub neutral_springs: bool,
     /// Gravity (m/s²).
     pub gravity: Vec3,
+    /// The tether of an unloaded chain (beyond the paper): each cone-anchored point is
+    /// pulled toward its rest place on its bone by `stiffness` (N/m) times the share of
+    /// `release` (N) the contraction force falls short of; off from `release` up.
+    pub tether: Tether,
 }
+
 impl MuscleChain {
     /// Tension of segment `i` (N, positive pulling its ends together) and its axial
     /// spring constant (N/m).
@@ -170,6 +178,14 @@ impl MuscleChain {
                 sc.f[i] += load.gravity * self.mass[i];
             }
         }
+        let tether = load.tether.at(load.contraction);
+        for i in 1..n - 1 {
+            sc.kt[i] = 0.0;
+            if let (true, Some(c)) = (tether > 0.0 && self.mass[i] > 0.0, self.cones[i]) {
+                sc.f[i] += (to.point(c.body, c.rest) - self.x[i]) * tether;
+                sc.kt[i] = tether;
+            }
+        }
         self.solve_implicit(h, damping, &mut sc);
         // The cones move with their bodies: each rotation as a matrix, built once.
         let thigh = (Mat3::from_quat(to.thigh.0), to.thigh.1);
@@ -217,8 +233,8 @@ impl MuscleChain {
     }
 
     /// Solves `(M + h·D + h²·K) Δv = h (f + h·K·v)` over the interior points, with the
-    /// isotropic segment stiffness (scalar tridiagonal; pinned points have Δv = 0), into
-    /// `sc.dv`.
+    /// isotropic segment stiffness and the tether (scalar tridiagonal; pinned points have
+    /// Δv = 0), into `sc.dv`.
     fn solve_implicit(&self, h: f32, damping: f32, sc: &mut ChainScratch) {
         let n = self.x.len();
         let pinned = |j: usize| j == 0 || j == n - 1 || self.mass[j] <= 0.0;
@@ -233,9 +249,12 @@ impl MuscleChain {
             let (diag, lower, upper, rhs) = if pinned(i) {
                 (1.0, 0.0, 0.0, Vec3::ZERO)
             } else {
-                let kv = (self.v[i - 1] - self.v[i]) * kl + (self.v[i + 1] - self.v[i]) * kr;
+                // The tether is a spring to a fixed place: stiffness on the diagonal only.
+                let kt = sc.kt[i];
+                let kv = (self.v[i - 1] - self.v[i]) * kl + (self.v[i + 1] - self.v[i]) * kr
+                    - self.v[i] * kt;
                 (
-                    self.mass[i] + 2.0 * dmp + (kl + kr) * hh,
+                    self.mass[i] + 2.0 * dmp + (kl + kr + kt) * hh,
                     if pinned(i - 1) { 0.0 } else { -dmp - kl * hh },
                     if pinned(i + 1) { 0.0 } else { -dmp - kr * hh },
                     (sc.f[i] + kv * h) * h,
@@ -273,6 +292,8 @@ impl MuscleChain {
             stiffness,
             neutral_springs: true,
             gravity,
+            // The rest places are what settling finds.
+            tether: Tether::default(),
         };
         for _ in 0..200 {
             self.advance(1e-3, frames, &load);
@@ -281,6 +302,9 @@ impl MuscleChain {
             }
         }
         self.v.iter_mut().for_each(|v| *v = Vec3::ZERO);
+        let x = std::mem::take(&mut self.x);
+        self.set_rest_places(&x, frames);
+        self.x = x;
         for i in 0..self.x.len() - 1 {
             self.rest_len[i] = self.segment(i).length.max(1e-4);
         }

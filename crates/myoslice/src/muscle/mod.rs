@@ -7,6 +7,7 @@ pub mod excursion;
 pub mod hill;
 pub(crate) mod snapshot;
 pub mod tendon;
+pub mod tether;
 pub mod unit;
 pub mod wrap;
 
@@ -17,5 +18,6 @@ pub use excursion::{Axis, Pull};
 pub use hill::{FibreState, HillForce, HillParams};
 pub(crate) use snapshot::MuscleSnapshot;
 pub use tendon::TendonModel;
+pub use tether::Tether;
 pub use unit::{ChainOptions, MUSCLE_DENSITY, MuscleUnit};
 pub use wrap::{WrapCylinder, WrapPath};

@@ -68,6 +68,13 @@ pub struct SimulationConfig {
     pub cone_half_angle_deg: f64,
     /// Chain spring constant relative to the muscle: k_i = this × F_max / L_i. Default 0.5.
     pub chain_stiffness: f64,
+    /// Tether of an unloaded chain (beyond the paper, [`crate::muscle::Tether`]): N/m
+    /// pulling each cone-anchored chain point toward its rest place on its bone. 0 leaves
+    /// the paper's chain. Default 600.
+    pub chain_tether: f64,
+    /// Muscle force (N) from which the tether is off; it fades linearly up to it.
+    /// Default 20.
+    pub chain_tether_release_n: f64,
     /// Tissue deformation options.
     pub tissue: TissueConfig,
 }
@@ -87,6 +94,8 @@ impl Default for SimulationConfig {
             chain_spacing_m: 0.04,
             cone_half_angle_deg: 15.0,
             chain_stiffness: 0.5,
+            chain_tether: 600.0,
+            chain_tether_release_n: 20.0,
             tissue: TissueConfig::default(),
         }
     }
@@ -116,6 +125,13 @@ impl SimulationConfig {
         check_range("chain_spacing_m", self.chain_spacing_m, 0.005, 0.5)?;
         check_range("cone_half_angle_deg", self.cone_half_angle_deg, 1.0, 89.0)?;
         check_range("chain_stiffness", self.chain_stiffness, 0.0, 100.0)?;
+        check_range("chain_tether", self.chain_tether, 0.0, 1e5)?;
+        check_range(
+            "chain_tether_release_n",
+            self.chain_tether_release_n,
+            0.0,
+            1e5,
+        )?;
         self.tissue.validate()?;
         Ok(())
     }

@@ -173,11 +173,16 @@ impl Simulation {
         // Moment arms (each step's torque report uses the last step's) and wrap state of
         // the chains as built.
         sim.reattach_muscles();
+        // The chains' equilibrium at rest (see `settle`), found without the tether, is
+        // where the tether holds an unloaded chain and the tissue's rest; the simulation
+        // itself starts from the chains as built.
+        let mut rest = sim.clone();
+        rest.config.chain_tether = 0.0;
+        rest.settle();
+        for (m, r) in sim.muscles.iter_mut().zip(&rest.muscles) {
+            m.chain.set_rest_places(&r.chain.x, &rest.frames);
+        }
         if let Some(bones) = bones {
-            // The tissue's rest is the chains' equilibrium at rest (see `settle`); the
-            // simulation itself starts from the chains as built.
-            let mut rest = sim.clone();
-            rest.settle();
             sim.tissue = Some(Tissue::new(
                 &sim.lattice,
                 &rest.muscles,

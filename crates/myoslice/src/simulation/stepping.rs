@@ -10,7 +10,7 @@ use super::{MuscleModel, Simulation, TendonModel};
 use crate::body::BodyId;
 use crate::error::{Error, Result, check_positive};
 use crate::muscle::hill::activation_rate;
-use crate::muscle::{Axis, ChainLoad, MuscleSnapshot};
+use crate::muscle::{Axis, ChainLoad, MuscleSnapshot, Tether};
 use crate::tissue::TissueBackup;
 
 /// Largest force (N) one muscle may apply to the shank: a hundred times the strongest
@@ -199,6 +199,10 @@ impl Simulation {
         let frames = self.frames;
         let knee_point = frames.point(BodyId::Thigh, knee.point);
         let knee_dir = frames.vector(BodyId::Thigh, knee.axis);
+        let tether = Tether {
+            stiffness: self.config.chain_tether as f32,
+            release: self.config.chain_tether_release_n as f32,
+        };
         for (m, sched) in self.muscles.iter_mut().zip(&self.schedules) {
             if let Some(s) = sched {
                 m.excitation = s.value(self.time);
@@ -208,6 +212,7 @@ impl Simulation {
                 stiffness: (self.config.chain_stiffness * m.hill.max_isometric_force) as f32,
                 neutral_springs: hill,
                 gravity,
+                tether,
             };
             let quiet = !m.crosses_knee
                 && m.excitation == 0.0
