@@ -76,7 +76,7 @@ impl BodyFrames {
         shank: (Quat::IDENTITY, Vec3::ZERO),
     };
 
-    pub(crate) fn of(&self, b: BodyId) -> (Quat, Vec3) {
+    fn of(&self, b: BodyId) -> (Quat, Vec3) {
         match b {
             BodyId::Thigh => self.thigh,
             BodyId::Shank => self.shank,

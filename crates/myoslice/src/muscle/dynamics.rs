@@ -144,14 +144,25 @@ impl MuscleChain {
         let damping = self.critical_damping(load);
         let mut sc = std::mem::take(&mut self.scratch);
         sc.fit(n);
+        // The bodies' rotations as matrices, built once: the pinned points, the tether's
+        // rest places and the cones move with them.
+        let thigh = (Mat3::from_quat(to.thigh.0), to.thigh.1);
+        let shank = (Mat3::from_quat(to.shank.0), to.shank.1);
+        let place = |b: BodyId, p: Vec3| {
+            let (m, t) = match b {
+                BodyId::Thigh => thigh,
+                BodyId::Shank => shank,
+            };
+            m * p + t
+        };
         // The pinned points move with their bodies; their velocity is that motion.
         let old_ends = (self.x[0], self.x[n - 1]);
-        self.x[0] = to.point(self.origin.body, self.origin.rest);
-        self.x[n - 1] = to.point(self.insertion.body, self.insertion.rest);
+        self.x[0] = place(self.origin.body, self.origin.rest);
+        self.x[n - 1] = place(self.insertion.body, self.insertion.rest);
         self.v[0] = (self.x[0] - old_ends.0) * inv_h;
         self.v[n - 1] = (self.x[n - 1] - old_ends.1) * inv_h;
         for (i, a) in &self.vias {
-            let p = to.point(a.body, a.rest);
+            let p = place(a.body, a.rest);
             self.v[*i] = (p - self.x[*i]) * inv_h;
             self.x[*i] = p;
         }
@@ -179,17 +190,16 @@ impl MuscleChain {
             }
         }
         let tether = load.tether.at(load.contraction);
-        for i in 1..n - 1 {
-            sc.kt[i] = 0.0;
-            if let (true, Some(c)) = (tether > 0.0 && self.mass[i] > 0.0, self.cones[i]) {
-                sc.f[i] += (to.point(c.body, c.rest) - self.x[i]) * tether;
-                sc.kt[i] = tether;
+        sc.kt.fill(0.0);
+        if tether > 0.0 {
+            for i in 1..n - 1 {
+                if let (true, Some(c)) = (self.mass[i] > 0.0, &self.cones[i]) {
+                    sc.f[i] += (place(c.body, c.rest) - self.x[i]) * tether;
+                    sc.kt[i] = tether;
+                }
             }
         }
         self.solve_implicit(h, damping, &mut sc);
-        // The cones move with their bodies: each rotation as a matrix, built once.
-        let thigh = (Mat3::from_quat(to.thigh.0), to.thigh.1);
-        let shank = (Mat3::from_quat(to.shank.0), to.shank.1);
         for i in 1..n - 1 {
             if self.mass[i] <= 0.0 {
                 continue; // pinned via point
