@@ -28,6 +28,9 @@ const NEAR_KNEE_M: f32 = 0.06;
 /// vertices are kept on their side of the contact plane (measured from the point, not the
 /// axis: it reaches less far from the axis at the sides of the knee).
 const KNEE_M: f32 = 0.12;
+/// How far (m) in front of the knee axis at rest a vertex may lie and still be kept on
+/// its side of the contact plane.
+const PLANE_FRONT_M: f32 = 0.01;
 /// Beyond this distance (m) from the bone a vertex's clear ball is renewed from the tree.
 const TREE_REFRESH_M: f32 = 0.004;
 /// How far (m) beyond the bone surface a pushed ring ends up.
@@ -206,7 +209,7 @@ impl BoneKeepOut {
             // plane: in front, the plane turns away as the knee bends.
             .filter(|(_, p)| {
                 p.distance(knee) < KNEE_M
-                    && (**p - rest_contact.point).dot(rest_contact.behind) > -0.01
+                    && (**p - rest_contact.point).dot(rest_contact.behind) > -PLANE_FRONT_M
             })
             .map(|(v, &p)| {
                 let thigh = p.z >= knee.z;

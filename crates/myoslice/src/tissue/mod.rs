@@ -16,6 +16,7 @@ pub mod muscle_shape;
 mod phases;
 pub mod polar;
 mod skin_breach;
+mod tissue_backup;
 mod tissue_config;
 
 use std::sync::{Arc, OnceLock};
@@ -33,13 +34,14 @@ use phases::Lap;
 pub use phases::TissuePhases;
 use skin_breach::ClosedSkin;
 pub use skin_breach::SkinBreach;
+pub(crate) use tissue_backup::TissueBackup;
 pub use tissue_config::TissueConfig;
 
 use crate::body::{BodyId, KneeAxis, body_of_bone};
 use crate::error::Result;
 use crate::lattice::{InnerContact, Lattice};
 use crate::muscle::{BodyFrames, MuscleUnit};
-use bone_keep_out::{Bones, KeepOutMemory};
+use bone_keep_out::Bones;
 pub use bone_overlap::BoneOverlap;
 use bone_slide::{BoneMesh, BoneSlide};
 use guard::Guard;
@@ -138,20 +140,6 @@ pub struct Tissue {
     pub(crate) pending: f64,
     /// How long each phase of the last update took.
     pub(crate) last_phases: TissuePhases,
-}
-
-/// A tissue's changing state, to put back after a failed update or `step` call.
-#[derive(Debug)]
-pub(crate) struct TissueBackup {
-    fat_x: Vec<Vec3>,
-    fat_rot: Vec<Quat>,
-    fat_free: Vec<bool>,
-    fat_active: Vec<bool>,
-    drift: Vec<Vec3>,
-    theta: f32,
-    metrics: LazyMetrics,
-    bone_slide: BoneSlide,
-    muscles: Vec<(Vec<Vec3>, f64, KeepOutMemory)>,
 }
 
 impl Tissue {
@@ -343,39 +331,6 @@ impl Tissue {
                 .muscles
                 .iter()
                 .all(|m| m.current.iter().all(|p| p.is_finite()))
-    }
-
-    /// Everything an update changes and the next one reads, the pairs watched against
-    /// bone included (where each walk starts). Not the clock: `step` advances it and puts
-    /// it back itself.
-    pub(crate) fn backup(&self) -> TissueBackup {
-        TissueBackup {
-            fat_x: self.fat.x.clone(),
-            fat_rot: self.fat.rot.clone(),
-            fat_free: self.fat.free.clone(),
-            fat_active: self.fat.active.clone(),
-            drift: self.drift.clone(),
-            theta: self.theta,
-            metrics: self.metrics.clone(),
-            bone_slide: self.bone_slide.clone(),
-            muscles: self
-                .muscles
-                .iter()
-                .map(|m| (m.current.clone(), m.volume_now, m.keep.memory()))
-                .collect(),
-        }
-    }
-
-    /// Puts back what [`Self::backup`] took.
-    pub(crate) fn restore(&mut self, b: TissueBackup) {
-        (self.fat.x, self.fat.rot) = (b.fat_x, b.fat_rot);
-        (self.fat.free, self.fat.active) = (b.fat_free, b.fat_active);
-        (self.drift, self.theta, self.metrics) = (b.drift, b.theta, b.metrics);
-        self.bone_slide = b.bone_slide;
-        for (shape, (c, v, keep)) in self.muscles.iter_mut().zip(b.muscles) {
-            (shape.current, shape.volume_now) = (c, v);
-            shape.keep.recall(keep);
-        }
     }
 
     /// The part of an update that reads the skeleton and the muscles: everything up to

@@ -1,0 +1,57 @@
+//! A tissue's changing state, taken before an update and put back if it fails.
+
+use glam::{Quat, Vec3};
+
+use super::Tissue;
+use super::bone_keep_out::KeepOutMemory;
+use super::bone_slide::BoneSlide;
+use super::metrics::LazyMetrics;
+
+/// A tissue's changing state, to put back after a failed update or `step` call.
+#[derive(Debug)]
+pub(crate) struct TissueBackup {
+    fat_x: Vec<Vec3>,
+    fat_rot: Vec<Quat>,
+    fat_free: Vec<bool>,
+    fat_active: Vec<bool>,
+    drift: Vec<Vec3>,
+    theta: f32,
+    metrics: LazyMetrics,
+    bone_slide: BoneSlide,
+    muscles: Vec<(Vec<Vec3>, f64, KeepOutMemory)>,
+}
+
+impl Tissue {
+    /// Everything an update changes and the next one reads, the pairs watched against
+    /// bone included (where each walk starts). Not the clock: `step` advances it and puts
+    /// it back itself.
+    pub(crate) fn backup(&self) -> TissueBackup {
+        TissueBackup {
+            fat_x: self.fat.x.clone(),
+            fat_rot: self.fat.rot.clone(),
+            fat_free: self.fat.free.clone(),
+            fat_active: self.fat.active.clone(),
+            drift: self.drift.clone(),
+            theta: self.theta,
+            metrics: self.metrics.clone(),
+            bone_slide: self.bone_slide.clone(),
+            muscles: self
+                .muscles
+                .iter()
+                .map(|m| (m.current.clone(), m.volume_now, m.keep.memory()))
+                .collect(),
+        }
+    }
+
+    /// Puts back what [`Self::backup`] took.
+    pub(crate) fn restore(&mut self, b: TissueBackup) {
+        (self.fat.x, self.fat.rot) = (b.fat_x, b.fat_rot);
+        (self.fat.free, self.fat.active) = (b.fat_free, b.fat_active);
+        (self.drift, self.theta, self.metrics) = (b.drift, b.theta, b.metrics);
+        self.bone_slide = b.bone_slide;
+        for (shape, (c, v, keep)) in self.muscles.iter_mut().zip(b.muscles) {
+            (shape.current, shape.volume_now) = (c, v);
+            shape.keep.recall(keep);
+        }
+    }
+}
