@@ -1,7 +1,7 @@
 //! Exact(-enough) self-intersection test of a triangle surface: does any triangle cross
 //! another one it shares no vertex with?
 
-use glam::{DVec3, UVec3, Vec3};
+use glam::{DVec3, UVec3, Vec3, Vec3A};
 use rayon::prelude::*;
 
 /// Number of pairs of triangles (sharing no vertex) whose interiors cross.
@@ -193,17 +193,24 @@ impl TriangleGrid {
             .par_chunks(256)
             .flat_map_iter(|chunk| {
                 let mut found = Vec::new();
+                // A cell's boxes side by side as SIMD vectors: its pair loop reads only
+                // these, and tests a pair's overlap with two compares, no branch per axis.
+                let mut cell: Vec<(Vec3A, Vec3A, UVec3, bool, u32)> = Vec::new();
                 for &k in chunk {
                     let here = UVec3::new((k % nx) as u32, (k % nxy / nx) as u32, (k / nxy) as u32);
-                    let c = &self.items[self.start[k] as usize..self.start[k + 1] as usize];
-                    for (ia, &a) in c.iter().enumerate() {
-                        let (ba, la, qa) = (boxes[a as usize], low[a as usize], queried(a));
-                        for &b in &c[ia + 1..] {
-                            if !(qa || queried(b)) || !ba.overlaps(&boxes[b as usize]) {
+                    let items = &self.items[self.start[k] as usize..self.start[k + 1] as usize];
+                    cell.clear();
+                    cell.extend(items.iter().map(|&a| {
+                        let b = &boxes[a as usize];
+                        (b.lo.into(), b.hi.into(), low[a as usize], queried(a), a)
+                    }));
+                    for (ia, &(alo, ahi, la, qa, a)) in cell.iter().enumerate() {
+                        for &(blo, bhi, lb, qb, b) in &cell[ia + 1..] {
+                            if !(qa || qb) || !(alo.cmple(bhi) & blo.cmple(ahi)).all() {
                                 continue;
                             }
                             // Each pair once: in the cell holding the overlap's low corner.
-                            if la.max(low[b as usize]) != here {
+                            if la.max(lb) != here {
                                 continue;
                             }
                             if let Some(p) = crossing(vertices, triangles, a, b) {
