@@ -8,7 +8,7 @@
 /// working muscle's line of pull is unchanged. Its rest places are the chains'
 /// equilibrium at rest without it (see `Simulation::new`), so at rest it pulls nothing.
 /// With it (150, 300 and 600 N/m tried; 600 kept) the muscle vertices out through the skin on
-/// the way back from a deep flexion fell from 1 361–1 452 to 200–289 at 49°.
+/// the way back from a deep flexion fell from 1 361–1 452 to 234–298 at 49°.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Tether {
     /// N/m per point (0: none, the paper's chain).
