@@ -79,6 +79,7 @@ class Simulation:
         tissue_rate_hz: float = 30.0,
         initial_knee_deg: float = 0.0,
         max_step_s: float = 0.001,
+        chain_tether: float | None = None,
         voxel_mm: float | None = None,
     ) -> Simulation:
         """The built-in lower-limb phantom (no files needed).
@@ -87,6 +88,8 @@ class Simulation:
         ``"compliant"`` (the Hill units' tendons stretch, and the fibre length becomes a
         state found every step); ``tissue=False`` skips the
         deformable fat and muscle volumes (faster; the tissue arrays are then empty).
+        ``chain_tether`` (N/m) pulls each relaxed muscle's chain points toward where they
+        rest on their bones (``None``: the default, 600; ``0``: the paper's free chain).
         """
 
     @staticmethod
@@ -104,6 +107,7 @@ class Simulation:
         tissue_rate_hz: float = 30.0,
         initial_knee_deg: float = 0.0,
         max_step_s: float = 0.001,
+        chain_tether: float | None = None,
     ) -> Simulation:
         """A model from a NIfTI label volume and its label table (JSON or TOML)."""
 

@@ -57,6 +57,7 @@ fn config(
     tissue_rate_hz: f64,
     initial_knee_deg: f64,
     max_step_s: f64,
+    chain_tether: Option<f64>,
 ) -> PyResult<SimulationConfig> {
     let model: MuscleModel = muscle_model.parse().or_py(py)?;
     let tendon: TendonModel = tendon.parse().or_py(py)?;
@@ -71,6 +72,9 @@ fn config(
     };
     c.tissue.enabled = tissue;
     c.tissue.rate_hz = tissue_rate_hz;
+    if let Some(k) = chain_tether {
+        c.chain_tether = k;
+    }
     c.validate().or_py(py)?;
     Ok(c)
 }
@@ -92,7 +96,7 @@ fn gpu(py: Python<'_>) -> PyResult<&'static Gpu> {
 impl PySimulation {
     /// The built-in lower-limb phantom (no files needed). Units are SI.
     #[staticmethod]
-    #[pyo3(signature = (*, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, initial_knee_deg = 0.0, max_step_s = 0.001, voxel_mm = None))]
+    #[pyo3(signature = (*, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, voxel_mm = None))]
     #[allow(clippy::too_many_arguments)]
     fn phantom(
         py: Python<'_>,
@@ -104,6 +108,7 @@ impl PySimulation {
         tissue_rate_hz: f64,
         initial_knee_deg: f64,
         max_step_s: f64,
+        chain_tether: Option<f64>,
         voxel_mm: Option<f64>,
     ) -> PyResult<Self> {
         let c = config(
@@ -116,6 +121,7 @@ impl PySimulation {
             tissue_rate_hz,
             initial_knee_deg,
             max_step_s,
+            chain_tether,
         )?;
         let sim = py
             .detach(move || -> myoslice::Result<Simulation> {
@@ -132,7 +138,7 @@ impl PySimulation {
 
     /// A NIfTI label volume with its label table (JSON or TOML).
     #[staticmethod]
-    #[pyo3(signature = (volume, labels, *, slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, initial_knee_deg = 0.0, max_step_s = 0.001))]
+    #[pyo3(signature = (volume, labels, *, slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None))]
     #[allow(clippy::too_many_arguments)]
     fn from_nifti(
         py: Python<'_>,
@@ -148,6 +154,7 @@ impl PySimulation {
         tissue_rate_hz: f64,
         initial_knee_deg: f64,
         max_step_s: f64,
+        chain_tether: Option<f64>,
     ) -> PyResult<Self> {
         check_path(py, &volume, "volume")?;
         check_path(py, &labels, "label table")?;
@@ -161,6 +168,7 @@ impl PySimulation {
             tissue_rate_hz,
             initial_knee_deg,
             max_step_s,
+            chain_tether,
         )?;
         let build = BuildOptions {
             reduction: SliceReduction {

@@ -161,6 +161,8 @@ def test_bad_set_knee(rigid: Simulation, angle: float, velocity: float) -> None:
         {"body_mass_kg": -1.0},
         {"height_m": math.nan},
         {"max_step_s": 0.0},
+        {"chain_tether": -1.0},
+        {"chain_tether": math.nan},
     ],
     ids=lambda kw: next(iter(kw)),
 )
