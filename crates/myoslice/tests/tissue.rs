@@ -563,7 +563,7 @@ fn muscles_reach_out_no_further_than_recorded(mut sim: Simulation) {
     );
     eprintln!("{summary}");
     assert!(
-        rising_45 < 0.006 && most < 11_000 && below_70 < 600 && farthest < 0.06,
+        rising_45 < 0.006 && most < 10_000 && below_70 < 600 && farthest < 0.06,
         "{summary}"
     );
 }

@@ -1,9 +1,10 @@
 //! The validity guard (beyond the paper, which reports fat that breaks): where the relaxed
 //! fat has an element below its allowed volume, or body-surface triangles behind the
-//! knee that cross, the vertices involved take their place in the knee fold (always
-//! valid), and the vertices around them give back half of their way to it (a soft edge);
-//! what that moved is checked again, round after round. Elsewhere the relaxed shape
-//! stands.
+//! knee that cross, the vertices involved give back half of their way to the knee fold
+//! (always valid), and the vertices around them keep at most halfway between all of
+//! theirs and that share (a soft edge);
+//! what that moved is checked again, round after round, and a vertex still involved after
+//! three halvings takes its place in the fold. Elsewhere the relaxed shape stands.
 //!
 //! After the first round only what the last round moved is looked at again.
 
@@ -17,8 +18,16 @@ use crate::lattice::hex_volume_f32 as hex_volume;
 /// Queried triangles up to which a round checks them without a grid.
 const FEW: usize = 64;
 
-/// Most rounds (each settles at least one more vertex).
+/// Most rounds (each moves at least one vertex further toward the fold).
 const MAX_ROUNDS: usize = 64;
+
+/// A vertex found in a bad element or a crossing keeps this share of its way from the
+/// fold (halved, round after round: 1, 1/2, 1/4, 1/8)...
+const GIVE_BACK: f32 = 0.5;
+/// ...and at or below this share it takes its place in the fold. Sent to the fold at
+/// once, the crease's skin lost the muscles it had followed out: 10 604 muscle vertices
+/// out through the skin of the phantom at 134° against 9 272 now.
+const LAST_SHARE: f32 = 0.2;
 
 /// Marks vertex `i` bad, listing it the first time.
 fn mark(bad: &mut [bool], list: &mut Vec<usize>, i: usize) {
@@ -158,7 +167,11 @@ impl Guard {
                 if self.share[i] > 0.0 {
                     self.moved_now[i] = true;
                     self.moved_list.push(i);
-                    self.share[i] = 0.0;
+                    self.share[i] = if self.share[i] > LAST_SHARE {
+                        self.share[i] * GIVE_BACK
+                    } else {
+                        0.0
+                    };
                 }
             }
             self.bad_list.clear();
