@@ -247,3 +247,8 @@ def test_bad_render_camera(rigid: Simulation) -> None:
 def test_bad_render_size(rigid: Simulation) -> None:
     with pytest.raises(InvalidInputError):
         rigid.render(0, 0)
+
+
+def test_bad_chain_tether_is_named() -> None:
+    with pytest.raises(InvalidInputError, match="chain_tether"):
+        Simulation.phantom(tissue=False, chain_tether=-1.0)

@@ -34,7 +34,9 @@ pub struct ConeAnchor {
     /// Smallest and largest distance (m) from the apex.
     pub depth: [f32; 2],
     /// The point's place at rest (body rest frame), where an unloaded chain's tether pulls
-    /// it back to (see [`super::ChainLoad::tether`]).
+    /// it back to (see [`super::ChainLoad::tether`]): where [`MuscleChain::settle`] left it
+    /// (under its settling tension), which a `Simulation` replaces by the chains' passive
+    /// equilibrium at rest.
     pub rest: Vec3,
 }
 
@@ -213,6 +215,7 @@ impl MuscleChain {
     /// Takes `x` (world, at `frames`) as where each cone-anchored point rests on its
     /// bone ([`ConeAnchor::rest`], where the tether pulls it back to).
     pub fn set_rest_places(&mut self, x: &[Vec3], frames: &BodyFrames) {
+        debug_assert_eq!(x.len(), self.cones.len(), "one place per chain point");
         for (p, c) in x.iter().zip(&mut self.cones) {
             if let Some(c) = c {
                 let (q, t) = frames.of(c.body);

@@ -242,7 +242,8 @@ impl MuscleChain {
         (k_max * m_min).sqrt()
     }
 
-    /// Solves `(M + h·D + h²·K) Δv = h (f + h·K·v)` over the interior points, with the
+    /// Solves `(M + h·D + h²·K) Δv = h (f − h·K·v)` (K = −∂f/∂x, the stiffness) over the
+    /// interior points, with the
     /// isotropic segment stiffness and the tether (scalar tridiagonal; pinned points have
     /// Δv = 0), into `sc.dv`.
     fn solve_implicit(&self, h: f32, damping: f32, sc: &mut ChainScratch) {

@@ -69,11 +69,13 @@ pub struct SimulationConfig {
     /// Chain spring constant relative to the muscle: k_i = this × F_max / L_i. Default 0.5.
     pub chain_stiffness: f64,
     /// Tether of an unloaded chain (beyond the paper, [`crate::muscle::Tether`]): N/m
-    /// pulling each cone-anchored chain point toward its rest place on its bone. 0 leaves
-    /// the paper's chain. Default 600.
+    /// pulling each cone-anchored chain point toward its rest place on its bone (per point:
+    /// the whole pull grows as `chain_spacing_m` shrinks). 0 leaves the paper's chain.
+    /// Default 600.
     pub chain_tether: f64,
-    /// Muscle force (N) from which the tether is off; it fades linearly up to it.
-    /// Default 20.
+    /// Muscle force (N) from which the tether is off; it fades linearly up to it (0 turns
+    /// the tether off). The same for every muscle: 1.5 % of the vastus medialis' F_max,
+    /// a quarter of the weakest catalogued muscles' (82 N). Default 20.
     pub chain_tether_release_n: f64,
     /// Tissue deformation options.
     pub tissue: TissueConfig,

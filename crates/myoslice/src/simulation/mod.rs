@@ -178,9 +178,9 @@ impl Simulation {
         // itself starts from the chains as built.
         let mut rest = sim.clone();
         rest.config.chain_tether = 0.0;
-        rest.settle();
+        let settled = rest.settle();
         for (m, r) in sim.muscles.iter_mut().zip(&rest.muscles) {
-            m.chain.set_rest_places(&r.chain.x, &rest.frames);
+            m.chain.set_rest_places(&r.chain.x, &settled);
         }
         if let Some(bones) = bones {
             sim.tissue = Some(Tissue::new(
@@ -201,7 +201,9 @@ impl Simulation {
     /// straightens a little under its passive tension and sags under gravity, and the
     /// tissue takes that equilibrium as its rest shape rather than showing the settling
     /// as deformation. The skeleton is put back where it was; the clock stays at 0.
-    fn settle(&mut self) {
+    /// Returns the bodies' poses the chains settled at (the knee may have moved a little
+    /// before the skeleton was put back), which their interior points are relative to.
+    fn settle(&mut self) -> BodyFrames {
         let skeleton = self.skeleton.clone();
         let muscles = self.muscles.clone();
         let h = self.config.max_step_s;
@@ -214,6 +216,7 @@ impl Simulation {
                 break;
             }
         }
+        let settled = self.current_frames();
         self.skeleton = skeleton;
         self.frames = self.current_frames();
         for m in &mut self.muscles {
@@ -221,6 +224,7 @@ impl Simulation {
         }
         self.reattach_muscles();
         (self.time, self.steps, self.knee_torque) = (0.0, 0, 0.0);
+        settled
     }
 
     /// After the bones moved by a jump: every chain back on its attachments, its wrap,

@@ -21,12 +21,17 @@ const FEW: usize = 64;
 /// Most rounds (each moves at least one vertex further toward the fold).
 const MAX_ROUNDS: usize = 64;
 
+/// From this round on a vertex found bad goes to the fold at once, as it did before the
+/// halving below: halving takes up to four rounds a vertex where one did, and the rounds
+/// must end well before [`MAX_ROUNDS`].
+const HALVING_ROUNDS: usize = 32;
+
 /// A vertex found in a bad element or a crossing keeps this share of its way from the
 /// fold (halved, round after round: 1, 1/2, 1/4, 1/8)...
 const GIVE_BACK: f32 = 0.5;
-/// ...and at or below this share it takes its place in the fold. Sent to the fold at
-/// once, the crease's skin lost the muscles it had followed out: 10 604 muscle vertices
-/// out through the skin of the phantom at 134° against 9 272 now.
+/// ...and a vertex found bad again at or below this share takes its place in the fold.
+/// (Sent to the fold at once, the crease's skin lost the muscles it had followed out:
+/// more muscle vertices out through it at deep flexion, see the README.)
 const LAST_SHARE: f32 = 0.2;
 
 /// Marks vertex `i` bad, listing it the first time.
@@ -167,7 +172,7 @@ impl Guard {
                 if self.share[i] > 0.0 {
                     self.moved_now[i] = true;
                     self.moved_list.push(i);
-                    self.share[i] = if self.share[i] > LAST_SHARE {
+                    self.share[i] = if round < HALVING_ROUNDS && self.share[i] > LAST_SHARE {
                         self.share[i] * GIVE_BACK
                     } else {
                         0.0

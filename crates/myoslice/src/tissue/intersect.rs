@@ -206,7 +206,8 @@ impl TriangleGrid {
                     }));
                     for (ia, &(alo, ahi, la, qa, a)) in cell.iter().enumerate() {
                         for &(blo, bhi, lb, qb, b) in &cell[ia + 1..] {
-                            if !(qa || qb) || !(alo.cmple(bhi) & blo.cmple(ahi)).all() {
+                            // As `Aabb::overlaps` (a NaN box meets every box).
+                            if !(qa || qb) || (alo.cmpgt(bhi) | blo.cmpgt(ahi)).any() {
                                 continue;
                             }
                             // Each pair once: in the cell holding the overlap's low corner.
