@@ -243,9 +243,8 @@ impl MuscleChain {
     }
 
     /// Solves `(M + h·D + h²·K) Δv = h (f − h·K·v)` (K = −∂f/∂x, the stiffness) over the
-    /// interior points, with the
-    /// isotropic segment stiffness and the tether (scalar tridiagonal; pinned points have
-    /// Δv = 0), into `sc.dv`.
+    /// interior points, with the isotropic segment stiffness and the tether (scalar
+    /// tridiagonal; pinned points have Δv = 0), into `sc.dv`.
     fn solve_implicit(&self, h: f32, damping: f32, sc: &mut ChainScratch) {
         let n = self.x.len();
         let pinned = |j: usize| j == 0 || j == n - 1 || self.mass[j] <= 0.0;
@@ -260,7 +259,8 @@ impl MuscleChain {
             let (diag, lower, upper, rhs) = if pinned(i) {
                 (1.0, 0.0, 0.0, Vec3::ZERO)
             } else {
-                // The tether is a spring to a fixed place: stiffness on the diagonal only.
+                // The tether pulls toward a place on a bone (at the step's end pose), not
+                // toward a neighbour: its stiffness is on the diagonal only.
                 let kt = sc.kt[i];
                 let kv = (self.v[i - 1] - self.v[i]) * kl + (self.v[i + 1] - self.v[i]) * kr
                     - self.v[i] * kt;

@@ -2,9 +2,9 @@
 //! fat has an element below its allowed volume, or body-surface triangles behind the
 //! knee that cross, the vertices involved give back half of their way to the knee fold
 //! (always valid), and the vertices around them keep at most halfway between all of
-//! theirs and that share (a soft edge);
-//! what that moved is checked again, round after round, and a vertex still involved after
-//! three halvings takes its place in the fold. Elsewhere the relaxed shape stands.
+//! theirs and that share (a soft edge); what that moved is checked again, round after
+//! round, and a vertex still involved after three halvings takes its place in the fold.
+//! Elsewhere the relaxed shape stands.
 //!
 //! After the first round only what the last round moved is looked at again.
 
