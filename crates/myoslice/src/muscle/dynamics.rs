@@ -148,11 +148,12 @@ impl MuscleChain {
         // rest places and the cones move with them.
         let thigh = (Mat3::from_quat(to.thigh.0), to.thigh.1);
         let shank = (Mat3::from_quat(to.shank.0), to.shank.1);
+        let pose = |b: BodyId| match b {
+            BodyId::Thigh => thigh,
+            BodyId::Shank => shank,
+        };
         let place = |b: BodyId, p: Vec3| {
-            let (m, t) = match b {
-                BodyId::Thigh => thigh,
-                BodyId::Shank => shank,
-            };
+            let (m, t) = pose(b);
             m * p + t
         };
         // The pinned points move with their bodies; their velocity is that motion.
@@ -208,11 +209,7 @@ impl MuscleChain {
             self.v[i] += sc.dv[i];
             self.x[i] += self.v[i] * h;
             if let Some(c) = self.cones[i] {
-                let (m, t) = match c.body {
-                    BodyId::Thigh => thigh,
-                    BodyId::Shank => shank,
-                };
-                let (apex, axis) = (m * c.apex + t, m * c.axis);
+                let (apex, axis) = (place(c.body, c.apex), pose(c.body).0 * c.axis);
                 let p = project_into_cone(self.x[i], apex, axis, self.cone_cos_tan);
                 self.x[i] = clamp_depth(p, apex, c.depth);
                 // Position-based correction: the velocity follows the projected motion.
