@@ -85,6 +85,13 @@ impl Bones<'_> {
         if p_rest.distance_squared(w.from) < w.clear * w.clear {
             return None;
         }
+        // Surely outside by the grid: that ball instead (the walk's start stays where the
+        // last walk ended, near where the vertex was when it last came close).
+        let bound = mesh.clear_bound(p_rest, &self.surfaces[b].1);
+        if bound > 0.0 {
+            (w.from, w.clear) = (p_rest, bound);
+            return None;
+        }
         let walk = mesh.walk_checked(w.nearest, p_rest, &self.surfaces[b].1);
         w.nearest = walk.triangle;
         if walk.inside {

@@ -8,6 +8,7 @@ use parry3d::query::PointQueryWithLocation;
 use parry3d::shape::TriMesh;
 use rayon::prelude::*;
 
+use super::distance_grid::DistanceGrid;
 use crate::body::BodyId;
 
 /// Most triangles a walk visits before it settles for the best seen.
@@ -31,6 +32,8 @@ pub(crate) struct BoneMesh {
     /// The triangles around each vertex (CSR: `fan[fan_start[v]..fan_start[v + 1]]`).
     fan_start: Vec<u32>,
     fan: Vec<u32>,
+    /// Exact distances from a coarse grid of points, for a quick bound.
+    grid: DistanceGrid,
 }
 
 /// Where a walk over a bone surface ended.
@@ -111,6 +114,15 @@ impl BoneMesh {
         }
         let (fan_start, corners) = super::incidence::vertex_corners(vertices.len(), &triangles);
         let fan = corners.into_iter().map(|c| c / 3).collect();
+        let (lo, hi) = vertices.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), v| (lo.min(*v), hi.max(*v)),
+        );
+        let grid = if vertices.is_empty() {
+            DistanceGrid::new(Vec3::ZERO, Vec3::ZERO)
+        } else {
+            DistanceGrid::new(lo, hi)
+        };
         Self {
             body,
             vertices,
@@ -121,6 +133,7 @@ impl BoneMesh {
             neighbours,
             fan_start,
             fan,
+            grid,
         }
     }
 
@@ -185,6 +198,17 @@ impl BoneMesh {
             inside: (p - best.0).dot(self.pseudo_normal(cur, best.1)) < 0.0,
             settled,
         }
+    }
+
+    /// How far (m) `p` (rest frame) surely lies outside the bone, zero when that is not
+    /// sure (see [`DistanceGrid`]; `tree` is this bone's parry mesh, for a cell's first
+    /// distance).
+    pub(crate) fn clear_bound(&self, p: Vec3, tree: &TriMesh) -> f32 {
+        self.grid.clear_of(p, |c| {
+            let w = self.walk_from_tree(tree, c);
+            let d = w.point.distance(c);
+            if w.inside { -d } else { d }
+        })
     }
 
     /// The nearest surface point to `p` (rest frame) from the tree's nearest triangle

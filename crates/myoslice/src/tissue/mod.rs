@@ -5,6 +5,7 @@
 mod bone_keep_out;
 mod bone_overlap;
 mod bone_slide;
+mod distance_grid;
 mod fat_lanes;
 pub mod fat_solver;
 mod guard;
