@@ -483,8 +483,9 @@ fn a_muscle_moved_out_of_the_body_is_found_outside_the_skin() {
     assert!(out[1..].iter().all(|b| b.vertices_over_1mm == 0));
 }
 
-/// `step` moves the muscles and the skeleton on while a tissue update runs its guard;
-/// stepped one update per call, nothing runs beside it. Both give the same bits.
+/// `step` moves the muscles and the skeleton on while a tissue update runs its guard,
+/// and places the next update's muscle shapes there; stepped one update per call,
+/// nothing runs beside it. Both give the same bits.
 #[test]
 fn muscles_stepping_beside_the_guard_give_the_same_bits_as_one_after_the_other() {
     // Steps and updates of exact binary fractions of a second: both runs add up the same

@@ -37,8 +37,10 @@ impl Simulation {
     /// says what failed.
     ///
     /// While a tissue update runs its validity guard, the muscles and the skeleton take
-    /// their steps to the next update on another thread: the guard reads neither, so the
-    /// results are those of running one after the other, bit for bit.
+    /// their steps to the next update on another thread, and the next update's muscle
+    /// shapes are placed there: the guard reads none of them, and placing the shapes
+    /// reads no fat, so the results are those of running one after the other, bit for
+    /// bit.
     pub fn step(&mut self, dt: f64) -> Result<()> {
         check_positive("dt", dt)?;
         if dt > 10.0 {
@@ -75,22 +77,24 @@ impl Simulation {
                 break;
             };
             let when = self.time;
-            // The guard never reads the skeleton or the muscles: they step on to the next
-            // update beside it (their steps are serial and the guard mostly so, so each
-            // fills the other's idle core). Same results as one after the other.
+            // The guard never reads the skeleton, the muscles or their shapes: they step
+            // on to the next update beside it, and that update's shapes are placed
+            // (their steps are serial and the guard mostly so, so each fills the other's
+            // idle core). Same results as one after the other.
             let joined = std::panic::catch_unwind(AssertUnwindSafe(|| {
                 let t0 = Instant::now();
                 tissue_backup.get_or_insert_with(|| t.backup());
                 let front = t.update_front(self.knee_angle(), &self.frames, &self.muscles);
                 let front_s = t0.elapsed();
-                let (back, next) = rayon::join(
-                    || {
-                        let t1 = Instant::now();
-                        let ok = t.update_back(front);
-                        (ok, t1.elapsed())
-                    },
-                    || self.segment(n, h, &mut taken, pending.as_mut(), period),
-                );
+                let (back, next) = t.update_back_beside(front, |placing| {
+                    let next = self.segment(n, h, &mut taken, pending.as_mut(), period);
+                    // The next update is due: its muscle shapes are placed now, while
+                    // the guard still runs.
+                    if let Ok(true) = next {
+                        placing.place(self.knee_angle(), &self.frames, &self.muscles);
+                    }
+                    next
+                });
                 (front_s, back, next)
             }));
             let (front_s, (updated, back_s), next) = match joined {

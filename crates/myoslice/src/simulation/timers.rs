@@ -33,10 +33,13 @@ pub struct StepTimers {
     /// Of `wall_s`, the part spent updating the tissue (s). The muscles and the skeleton
     /// step on beside each update's validity guard (see
     /// [`Simulation::step`](crate::Simulation::step)), so their steps can run within it
-    /// (on another thread, or on the guard's own while it waits for its parallel work).
+    /// (on another thread, or on the guard's own while it waits for its parallel work),
+    /// and so can the placing of the next update's muscle shapes once they are done.
     pub tissue_wall_s: f64,
-    /// Of `tissue_wall_s`, each phase of the updates (the rest is the backup a call
-    /// takes before its first update and the check that everything stayed finite).
+    /// Each phase of the updates: part of `tissue_wall_s` (the rest is the backup a call
+    /// takes before its first update and the check that everything stayed finite), but
+    /// for muscle shapes placed beside the last update's guard, which count in
+    /// `muscle_shapes_s` only.
     pub tissue_phases: TissuePhases,
 }
 

@@ -13,12 +13,14 @@ mod incidence;
 pub mod intersect;
 pub mod knee_fold;
 pub mod metrics;
+mod muscle_placing;
 pub mod muscle_shape;
 mod phases;
 pub mod polar;
 mod skin_breach;
 mod tissue_backup;
 mod tissue_config;
+mod update_back;
 
 use std::sync::{Arc, OnceLock};
 
@@ -30,6 +32,7 @@ pub use fat_solver::FatSolver;
 pub use knee_fold::{Contact, FoldZone, KneeFold};
 use metrics::LazyMetrics;
 pub use metrics::TissueMetrics;
+use muscle_placing::Placing;
 pub use muscle_shape::MuscleShape;
 use phases::Lap;
 pub use phases::TissuePhases;
@@ -94,6 +97,8 @@ struct TissueStatic {
 #[derive(Debug)]
 pub(crate) struct Front {
     phases: TissuePhases,
+    /// Whether every muscle vertex came out finite.
+    shapes_finite: bool,
 }
 
 /// Buffers an update fills anew each time, kept to avoid allocating them. A copy of the
@@ -141,6 +146,10 @@ pub struct Tissue {
     pub(crate) pending: f64,
     /// How long each phase of the last update took.
     pub(crate) last_phases: TissuePhases,
+    /// The muscle shapes are placed already for the coming update (placed beside the last
+    /// one's guard, see [`Self::update_back_beside`]): the time it took and whether all
+    /// were finite.
+    placed: Option<(f64, bool)>,
 }
 
 impl Tissue {
@@ -237,6 +246,7 @@ impl Tissue {
             metrics: LazyMetrics::built(),
             pending: 0.0,
             last_phases: TissuePhases::default(),
+            placed: None,
         };
         Ok(tissue)
     }
@@ -322,73 +332,45 @@ impl Tissue {
         self.update_back(front)
     }
 
-    /// Finishes an update [`Self::update_front`] began. Returns false if anything became
-    /// non-finite (the caller puts back a [`TissueBackup`]).
-    pub(crate) fn update_back(&mut self, front: Front) -> bool {
-        self.deform_back(front);
-        self.fat.x.iter().all(|p| p.is_finite())
-            && self.drift.iter().all(|p| p.is_finite())
-            && self
-                .muscles
-                .iter()
-                .all(|m| m.current.iter().all(|p| p.is_finite()))
-    }
-
     /// The part of an update that reads the skeleton and the muscles: everything up to
-    /// the validity guard. [`Self::update_back`] finishes it; in between, the caller may
-    /// move the skeleton and the muscles on (the back half never reads them).
+    /// the validity guard, starting with the muscle shapes unless they were placed for
+    /// this update already (beside the last one's guard, see
+    /// [`Self::update_back_beside`]). [`Self::update_back`] finishes it; in between, the
+    /// caller may move the skeleton and the muscles on (the back half never reads them).
     pub(crate) fn update_front(
         &mut self,
         knee_angle: f64,
         frames: &BodyFrames,
         muscles: &[MuscleUnit],
     ) -> Front {
+        let (shapes_s, shapes_finite) = match self.placed.take() {
+            Some(placed) => placed,
+            None => {
+                let mut placing = Placing {
+                    shapes: &mut self.muscles,
+                    fixed: &self.fixed,
+                    knee: self.knee,
+                    config: &self.config,
+                    layers: self.layers,
+                    placed: None,
+                };
+                placing.place(knee_angle, frames, muscles);
+                placing.placed.unwrap_or((0.0, false))
+            }
+        };
         let mut lap = Lap::start();
-        let mut phases = TissuePhases::default();
+        let mut phases = TissuePhases {
+            muscle_shapes_s: shapes_s,
+            ..TissuePhases::default()
+        };
         let theta = knee_angle as f32;
         let fold = KneeFold::new(&self.knee, theta);
         let (tq, tt) = frames.thigh;
         let gap = self.config.contact_gap_m as f32;
-        // Muscles keep further from the contact than the fat over them.
-        let muscle_gap = gap + LAYER_GAP * (self.layers as f32 + 1.0);
-        let contact = fold.contact(muscle_gap);
-        let contact = Contact {
-            point: tq * contact.point + tt,
-            normal: tq * contact.normal,
-            behind: tq * contact.behind,
-            ..contact
-        };
-        // Muscles are not squashed onto the contact plane (their volume is the invariant
-        // kept; the fat over them is): bones push them aside ring by ring, and the plane
-        // pushes whole rings back to their side of it, a little each round.
+        let contact =
+            muscle_placing::muscle_contact(&fold, &self.config, self.layers, frames.thigh);
         let fixed = Arc::clone(&self.fixed);
-        let bones = Bones {
-            meshes: &fixed.bone_meshes,
-            surfaces: &fixed.bones,
-            frames,
-            fade: bone_keep_out::fade_per_update(self.config.rate_hz),
-            contact: Some(contact),
-        };
-        self.muscles
-            .par_iter_mut()
-            .zip(muscles)
-            .for_each(|(shape, m)| {
-                // A muscle resting on one body keeps its rest shape and moves with it
-                // (neither bone nor contact plane shifts its rings: placed from its chain
-                // and kept off the plane, such muscles came out more, 9 850 → 10 233).
-                let quiet = !m.crosses_knee && m.activation < 1e-4 && m.excitation == 0.0;
-                match m.chain.single_body() {
-                    Some(b) if quiet => {
-                        let (q, t) = match b {
-                            BodyId::Thigh => frames.thigh,
-                            BodyId::Shank => frames.shank,
-                        };
-                        shape.carry(q, t);
-                    }
-                    _ => shape.update_clear_of(&m.chain, &fold, &bones),
-                }
-            });
-        phases.muscle_shapes_s = lap.lap();
+
         let mut sc = std::mem::take(&mut self.scratch);
         // The fold of the rest shape is valid: the fallback of the guard below.
         knee_fold::fold_hexes(
@@ -501,32 +483,10 @@ impl Tissue {
         self.theta = theta;
         self.scratch = sc;
         phases.bone_sliding_s = lap.lap();
-        Front { phases }
-    }
-
-    /// The validity guard and the momentum carried to the next update (see
-    /// [`Self::update_back`]).
-    fn deform_back(&mut self, front: Front) {
-        // Timed from here: the back half may start a little after the front ended.
-        let mut lap = Lap::start();
-        let Front { mut phases } = front;
-        let fixed = Arc::clone(&self.fixed);
-        let mut sc = std::mem::take(&mut self.scratch);
-        let (safe, guess) = (&sc.safe, &sc.guess);
-        let guarded = sc.guard.run(
-            &mut self.fat,
-            safe,
-            &fixed.guard_triangles,
-            self.config.min_volume_ratio as f32,
-            self.config.surface_guard,
-        );
-        for i in 0..self.drift.len() {
-            self.drift[i] = self.fat.x[i] - guess[i];
+        Front {
+            phases,
+            shapes_finite,
         }
-        self.scratch = sc;
-        self.metrics = LazyMetrics::updated(guarded);
-        phases.guard_s = lap.lap();
-        self.last_phases = phases;
     }
 
     /// Pulls inner vertices facing a muscle toward their targets (the paper's rule, see

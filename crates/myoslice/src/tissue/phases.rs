@@ -13,7 +13,9 @@ use std::time::Instant;
 /// ```
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct TissuePhases {
-    /// Muscle shapes placed on their chains, with their keep-out from bone.
+    /// Muscle shapes placed on their chains, with their keep-out from bone (when
+    /// `Simulation::step` runs several updates in one call, beside the last update's
+    /// guard).
     pub muscle_shapes_s: f64,
     /// The knee fold of the rest shape (the first guess's base and the guard's fallback).
     pub knee_fold_s: f64,

@@ -49,6 +49,8 @@ impl Tissue {
         (self.fat.free, self.fat.active) = (b.fat_free, b.fat_active);
         (self.drift, self.theta, self.metrics) = (b.drift, b.theta, b.metrics);
         self.bone_slide = b.bone_slide;
+        // Shapes placed ahead for an update that will not come now.
+        self.placed = None;
         for (shape, (c, v, keep)) in self.muscles.iter_mut().zip(b.muscles) {
             (shape.current, shape.volume_now) = (c, v);
             shape.keep.recall(keep);
