@@ -80,6 +80,7 @@ class Simulation:
         initial_knee_deg: float = 0.0,
         max_step_s: float = 0.001,
         chain_tether: float | None = None,
+        chain_tether_release_n: float | None = None,
         voxel_mm: float | None = None,
     ) -> Simulation:
         """The built-in lower-limb phantom (no files needed).
@@ -89,7 +90,9 @@ class Simulation:
         state found every step); ``tissue=False`` skips the
         deformable fat and muscle volumes (faster; the tissue arrays are then empty).
         ``chain_tether`` (N/m) pulls each relaxed muscle's chain points toward where they
-        rest on their bones (``None``: the default, 600; ``0``: the paper's free chain).
+        rest on their bones (``None``: the default, 600; ``0``: the paper's free chain),
+        fading out as the muscle's force rises to ``chain_tether_release_n`` (N; ``None``:
+        the default, 20).
         """
 
     @staticmethod
@@ -108,6 +111,7 @@ class Simulation:
         initial_knee_deg: float = 0.0,
         max_step_s: float = 0.001,
         chain_tether: float | None = None,
+        chain_tether_release_n: float | None = None,
     ) -> Simulation:
         """A model from a NIfTI label volume and its label table (JSON or TOML)."""
 

@@ -2,6 +2,7 @@
 //! core crate; this file converts arguments, arrays and errors.
 
 mod arrays;
+mod config;
 mod errors;
 
 use std::path::PathBuf;
@@ -17,6 +18,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use arrays::{SurfaceArrays, check_path, metric_array, per_muscle_reach, tri_array, vec3_array};
+use config::ConfigArgs;
 use errors::{Kind, OrPy, py_err};
 
 /// A checkpoint of a simulation (`Simulation.state()` / `set_state()`).
@@ -46,39 +48,6 @@ struct PySimulation {
     offscreen: Option<(u32, u32, Offscreen)>,
 }
 
-#[allow(clippy::too_many_arguments)]
-fn config(
-    py: Python<'_>,
-    body_mass_kg: f64,
-    height_m: f64,
-    muscle_model: &str,
-    tendon: &str,
-    tissue: bool,
-    tissue_rate_hz: f64,
-    initial_knee_deg: f64,
-    max_step_s: f64,
-    chain_tether: Option<f64>,
-) -> PyResult<SimulationConfig> {
-    let model: MuscleModel = muscle_model.parse().or_py(py)?;
-    let tendon: TendonModel = tendon.parse().or_py(py)?;
-    let mut c = SimulationConfig {
-        body_mass_kg,
-        tendon,
-        height_m,
-        muscle_model: model,
-        initial_knee_deg,
-        max_step_s,
-        ..SimulationConfig::default()
-    };
-    c.tissue.enabled = tissue;
-    c.tissue.rate_hz = tissue_rate_hz;
-    if let Some(k) = chain_tether {
-        c.chain_tether = k;
-    }
-    c.validate().or_py(py)?;
-    Ok(c)
-}
-
 fn gpu(py: Python<'_>) -> PyResult<&'static Gpu> {
     static GPU: OnceLock<Result<Gpu, String>> = OnceLock::new();
     GPU.get_or_init(|| Gpu::headless().map_err(|e| e.to_string()))
@@ -96,7 +65,7 @@ fn gpu(py: Python<'_>) -> PyResult<&'static Gpu> {
 impl PySimulation {
     /// The built-in lower-limb phantom (no files needed). Units are SI.
     #[staticmethod]
-    #[pyo3(signature = (*, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, voxel_mm = None))]
+    #[pyo3(signature = (*, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, chain_tether_release_n = None, voxel_mm = None))]
     #[allow(clippy::too_many_arguments)]
     fn phantom(
         py: Python<'_>,
@@ -109,10 +78,10 @@ impl PySimulation {
         initial_knee_deg: f64,
         max_step_s: f64,
         chain_tether: Option<f64>,
+        chain_tether_release_n: Option<f64>,
         voxel_mm: Option<f64>,
     ) -> PyResult<Self> {
-        let c = config(
-            py,
+        let c = ConfigArgs {
             body_mass_kg,
             height_m,
             muscle_model,
@@ -122,7 +91,9 @@ impl PySimulation {
             initial_knee_deg,
             max_step_s,
             chain_tether,
-        )?;
+            chain_tether_release_n,
+        }
+        .config(py)?;
         let sim = py
             .detach(move || -> myoslice::Result<Simulation> {
                 let (v, t) = Phantom { voxel_mm }.generate()?;
@@ -138,7 +109,7 @@ impl PySimulation {
 
     /// A NIfTI label volume with its label table (JSON or TOML).
     #[staticmethod]
-    #[pyo3(signature = (volume, labels, *, slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None))]
+    #[pyo3(signature = (volume, labels, *, slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, chain_tether_release_n = None))]
     #[allow(clippy::too_many_arguments)]
     fn from_nifti(
         py: Python<'_>,
@@ -155,11 +126,11 @@ impl PySimulation {
         initial_knee_deg: f64,
         max_step_s: f64,
         chain_tether: Option<f64>,
+        chain_tether_release_n: Option<f64>,
     ) -> PyResult<Self> {
         check_path(py, &volume, "volume")?;
         check_path(py, &labels, "label table")?;
-        let c = config(
-            py,
+        let c = ConfigArgs {
             body_mass_kg,
             height_m,
             muscle_model,
@@ -169,7 +140,9 @@ impl PySimulation {
             initial_knee_deg,
             max_step_s,
             chain_tether,
-        )?;
+            chain_tether_release_n,
+        }
+        .config(py)?;
         let build = BuildOptions {
             reduction: SliceReduction {
                 slice_step,

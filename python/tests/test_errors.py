@@ -163,6 +163,8 @@ def test_bad_set_knee(rigid: Simulation, angle: float, velocity: float) -> None:
         {"max_step_s": 0.0},
         {"chain_tether": -1.0},
         {"chain_tether": math.nan},
+        {"chain_tether_release_n": -1.0},
+        {"chain_tether_release_n": math.inf},
     ],
     ids=lambda kw: next(iter(kw)),
 )
@@ -252,3 +254,5 @@ def test_bad_render_size(rigid: Simulation) -> None:
 def test_bad_chain_tether_is_named() -> None:
     with pytest.raises(InvalidInputError, match="chain_tether"):
         Simulation.phantom(tissue=False, chain_tether=-1.0)
+    with pytest.raises(InvalidInputError, match="chain_tether_release_n"):
+        Simulation.phantom(tissue=False, chain_tether_release_n=-1.0)

@@ -17,6 +17,8 @@
 //! duration_s = 1.0            # required
 //! step_s = 0.001              # default 0.001
 //! initial_knee_deg = 0.0      # default 0
+//! chain_tether = 600.0        # N/m pulling relaxed chains to rest, 0 = off (default 600)
+//! chain_tether_release_n = 20.0  # muscle force (N) where the tether lets go (default 20)
 //!
 //! [tissue]                    # every TissueConfig field, all optional
 //! rate_hz = 30.0
@@ -122,6 +124,14 @@ pub struct SimulationSection {
     /// Knee angle at the start (deg).
     #[serde(default)]
     pub initial_knee_deg: f64,
+    /// The chains' tether (N/m; [`SimulationConfig::chain_tether`]); its default when
+    /// absent.
+    #[serde(default)]
+    pub chain_tether: Option<f64>,
+    /// Muscle force (N) at which the tether lets go
+    /// ([`SimulationConfig::chain_tether_release_n`]); its default when absent.
+    #[serde(default)]
+    pub chain_tether_release_n: Option<f64>,
 }
 
 fn default_model() -> MuscleModel {
@@ -224,6 +234,19 @@ impl Scenario {
                 line_of("step_s")
             )));
         }
+        for (key, value) in [
+            ("chain_tether", s.chain_tether),
+            ("chain_tether_release_n", s.chain_tether_release_n),
+        ] {
+            if let Some(v) = value
+                && !(v.is_finite() && (0.0..=1e5).contains(&v))
+            {
+                return Err(err(format!(
+                    "simulation.{key} = {v}{}: expected 0 to 100000",
+                    line_of(&format!("{key} "))
+                )));
+            }
+        }
         match raw.model.source.as_str() {
             "phantom" => {}
             "nifti" => {
@@ -274,15 +297,19 @@ impl Scenario {
 
     /// The simulation configuration it describes.
     pub fn config(&self) -> SimulationConfig {
+        let d = SimulationConfig::default();
+        let s = &self.simulation;
         SimulationConfig {
             body_mass_kg: self.body.mass_kg,
             height_m: self.body.height_m,
-            muscle_model: self.simulation.muscle_model,
-            tendon: self.simulation.tendon,
-            initial_knee_deg: self.simulation.initial_knee_deg,
-            max_step_s: self.simulation.step_s,
+            muscle_model: s.muscle_model,
+            tendon: s.tendon,
+            initial_knee_deg: s.initial_knee_deg,
+            max_step_s: s.step_s,
+            chain_tether: s.chain_tether.unwrap_or(d.chain_tether),
+            chain_tether_release_n: s.chain_tether_release_n.unwrap_or(d.chain_tether_release_n),
             tissue: self.tissue.clone(),
-            ..SimulationConfig::default()
+            ..d
         }
     }
 
@@ -440,5 +467,37 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("excitation.x"), "{e}");
+        let e = parse(
+            "[simulation]\nduration_s = 1\nchain_tether = 600\nchain_tether_release_n = -5\n",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("simulation.chain_tether_release_n = -5") && e.contains("line 4"),
+            "{e}"
+        );
+        let e = parse("[simulation]\nduration_s = 1\nchain_tether = nan\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("simulation.chain_tether = NaN") && e.contains("line 3"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn the_chains_tether_is_read_from_the_simulation_section_or_left_at_its_default() {
+        let d = SimulationConfig::default();
+        let s = parse("[simulation]\nduration_s = 1\n").unwrap().config();
+        assert_eq!(
+            (s.chain_tether, s.chain_tether_release_n),
+            (d.chain_tether, d.chain_tether_release_n)
+        );
+        let s = parse(
+            "[simulation]\nduration_s = 1\nchain_tether = 0\nchain_tether_release_n = 35.5\n",
+        )
+        .unwrap()
+        .config();
+        assert_eq!((s.chain_tether, s.chain_tether_release_n), (0.0, 35.5));
     }
 }

@@ -1,0 +1,48 @@
+//! The simulation configuration from the constructors' keyword arguments.
+
+use myoslice::prelude::*;
+use pyo3::prelude::*;
+
+use crate::errors::OrPy;
+
+/// The keyword arguments `Simulation.phantom` and `Simulation.from_nifti` share.
+pub(crate) struct ConfigArgs<'a> {
+    pub(crate) body_mass_kg: f64,
+    pub(crate) height_m: f64,
+    pub(crate) muscle_model: &'a str,
+    pub(crate) tendon: &'a str,
+    pub(crate) tissue: bool,
+    pub(crate) tissue_rate_hz: f64,
+    pub(crate) initial_knee_deg: f64,
+    pub(crate) max_step_s: f64,
+    /// None: the core's default.
+    pub(crate) chain_tether: Option<f64>,
+    /// None: the core's default.
+    pub(crate) chain_tether_release_n: Option<f64>,
+}
+
+impl ConfigArgs<'_> {
+    /// The configuration, checked (a bad value raises `ValueError` naming it).
+    pub(crate) fn config(self, py: Python<'_>) -> PyResult<SimulationConfig> {
+        let model: MuscleModel = self.muscle_model.parse().or_py(py)?;
+        let tendon: TendonModel = self.tendon.parse().or_py(py)?;
+        let d = SimulationConfig::default();
+        let mut c = SimulationConfig {
+            body_mass_kg: self.body_mass_kg,
+            tendon,
+            height_m: self.height_m,
+            muscle_model: model,
+            initial_knee_deg: self.initial_knee_deg,
+            max_step_s: self.max_step_s,
+            chain_tether: self.chain_tether.unwrap_or(d.chain_tether),
+            chain_tether_release_n: self
+                .chain_tether_release_n
+                .unwrap_or(d.chain_tether_release_n),
+            ..d
+        };
+        c.tissue.enabled = self.tissue;
+        c.tissue.rate_hz = self.tissue_rate_hz;
+        c.validate().or_py(py)?;
+        Ok(c)
+    }
+}
