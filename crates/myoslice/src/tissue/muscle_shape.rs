@@ -213,11 +213,18 @@ impl MuscleShape {
         // single-precision sum accurate.
         let origin = chain.x[chain.x.len() / 2];
         let mut across_fix = 1.0f32;
+        // Each ring's √λ, and its cross-section's scale this pass (once per ring, not per
+        // vertex: the same operations on the same values, so the same bits).
+        let root: Vec<f32> = rings.iter().map(|r| r.3.sqrt()).collect();
+        let mut across = vec![0.0f32; rings.len()];
         for pass in 0..VOLUME_PASSES {
+            for (a, r) in across.iter_mut().zip(&root) {
+                *a = across_fix / r;
+            }
             for (vi, p) in self.current.iter_mut().enumerate() {
-                let (c, m, axis_now, lambda) = rings[self.ring_of[vi] as usize];
-                let across = across_fix / lambda.sqrt();
-                *p = c + axis_now * (self.axial[vi] * lambda) + m * (self.perp[vi] * across);
+                let ring = self.ring_of[vi] as usize;
+                let (c, m, axis_now, lambda) = rings[ring];
+                *p = c + axis_now * (self.axial[vi] * lambda) + m * (self.perp[vi] * across[ring]);
             }
             if let Some(c) = contact {
                 for (p, r) in self.current.iter_mut().zip(&self.rest) {
