@@ -536,7 +536,9 @@ fn muscles_stepping_beside_the_guard_give_the_same_bits_as_one_after_the_other()
 /// away (the phantom's vastus medialis came 21 mm out). Below 70° it holds the chains'
 /// tether, which brings the relaxed calf back on the way back (without: 1 361 vertices on
 /// the phantom, 1 452 on the Visible Human; without the contact plane on muscles either,
-/// 2 237 and 2 207), and at most the guard's halving (without: 10 604 and 10 260).
+/// 2 237 and 2 207), and at most the guard's halving (without: 10 604 and 10 260). The
+/// farthest holds the contact plane's reach of 20 cm for muscles (12 cm before: 44.9 and
+/// 45.2 mm, the gastrocnemii's bellies past the plane into the thigh's side).
 fn muscles_reach_out_no_further_than_recorded(mut sim: Simulation) {
     let (mut most, mut below_70, mut farthest, mut rising_45) = (0usize, 0usize, 0.0f32, 0.0f32);
     let mut top = 0.0f64;
@@ -567,7 +569,7 @@ fn muscles_reach_out_no_further_than_recorded(mut sim: Simulation) {
     );
     eprintln!("{summary}");
     assert!(
-        rising_45 < 0.006 && most < 10_000 && below_70 < 600 && farthest < 0.06,
+        rising_45 < 0.006 && most < 10_000 && below_70 < 600 && farthest < 0.042,
         "{summary}"
     );
 }
