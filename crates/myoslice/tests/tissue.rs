@@ -530,15 +530,15 @@ fn muscles_stepping_beside_the_guard_give_the_same_bits_as_one_after_the_other()
 /// against the bound recorded: the most vertices more than 1 mm out at one update (and
 /// below 70°), the farthest, and the farthest while the knee first bends to 45°.
 ///
-/// A regression bound, not a goal: the fold drags the skin behind the knee further round
-/// than the muscles under it (see the README), and the bound records how far. While the
-/// knee first bends to 45° it is tighter: rings pushed off a bone from both sides ran
-/// away (the phantom's vastus medialis came 21 mm out). Below 70° it holds the chains'
-/// tether, which brings the relaxed calf back on the way back (without: 1 361 vertices on
-/// the phantom, 1 452 on the Visible Human; without the contact plane on muscles either,
-/// 2 237 and 2 207), and at most the guard's halving (without: 10 604 and 10 260). The
-/// farthest holds the contact plane's reach of 20 cm for muscles (12 cm before: 44.9 and
-/// 45.2 mm, the gastrocnemii's bellies past the plane into the thigh's side).
+/// A regression bound, not a goal: muscles still overlap across the contact plane behind
+/// the knee (see the README), and the bound records how far. While the knee first bends
+/// to 45° it is tighter: rings pushed off a bone from both sides ran away (the phantom's
+/// vastus medialis came 21 mm out). Below 70° it holds the chains' tether, which brings
+/// the relaxed calf back on the way back (without: 1 361 vertices on the phantom, 1 452
+/// on the Visible Human; without the contact plane on muscles either, 2 237 and 2 207).
+/// The most at one update and the farthest hold the skin kept from drawing back from the
+/// plane (without: 9 022 and 8 815 vertices, 39.7 and 39.6 mm; with the plane's reach
+/// for muscles at 12 cm too, 44.9 and 45.2 mm).
 fn muscles_reach_out_no_further_than_recorded(mut sim: Simulation) {
     let (mut most, mut below_70, mut farthest, mut rising_45) = (0usize, 0usize, 0.0f32, 0.0f32);
     let mut top = 0.0f64;
@@ -569,7 +569,7 @@ fn muscles_reach_out_no_further_than_recorded(mut sim: Simulation) {
     );
     eprintln!("{summary}");
     assert!(
-        rising_45 < 0.006 && most < 10_000 && below_70 < 600 && farthest < 0.042,
+        rising_45 < 0.006 && most < 2_500 && below_70 < 600 && farthest < 0.025,
         "{summary}"
     );
 }

@@ -5,6 +5,7 @@
 mod bone_keep_out;
 mod bone_overlap;
 mod bone_slide;
+mod crease;
 mod distance_grid;
 mod fat_lanes;
 pub mod fat_solver;
@@ -76,6 +77,9 @@ struct TissueStatic {
     thigh_side: Vec<bool>,
     /// Fat vertices behind the knee axis at rest (the contact acts there).
     posterior: Vec<u32>,
+    /// The skin's among them (kept from drawing back from the contact plane, see
+    /// [`crease`]).
+    posterior_skin: Vec<u32>,
     /// Body-surface triangles near the knee, checked for crossings after each update.
     guard_triangles: Vec<[u32; 3]>,
     /// Where the knee fold can bend the fat.
@@ -114,6 +118,9 @@ struct Scratch {
     moving: Vec<bool>,
     /// Where each inner vertex facing a muscle is pulled this update.
     muscle_targets: Vec<(u32, Vec3)>,
+    /// How far from the contact plane each skin vertex behind the knee may lie this
+    /// update, and how much of the way back it is pulled ([`crease::skin_limits`]).
+    skin_limits: Vec<(f32, f32)>,
     guard: Guard,
 }
 
@@ -218,11 +225,17 @@ impl Tissue {
             .into_iter()
             .map(|(h, q)| (h, q, crate::lattice::quad_area(&fat.vertices, &q)))
             .collect();
+        let posterior: Vec<u32> = (0..nv as u32)
+            .filter(|&v| fold.is_posterior(fat.vertices[v as usize]))
+            .collect();
         let fixed = TissueStatic {
             muscle_ref,
             thigh_side: fat.vertices.iter().map(|p| p.z >= kz).collect(),
-            posterior: (0..nv as u32)
-                .filter(|&v| fold.is_posterior(fat.vertices[v as usize]))
+            posterior: posterior.clone(),
+            posterior_skin: posterior
+                .iter()
+                .copied()
+                .filter(|&v| v as usize % (fat.layers + 1) == fat.layers)
                 .collect(),
             guard_triangles,
             zone: FoldZone::new(&knee, &fat.vertices, &fat.hexes),
@@ -372,6 +385,14 @@ impl Tissue {
         let fixed = Arc::clone(&self.fixed);
 
         let mut sc = std::mem::take(&mut self.scratch);
+        crease::skin_limits(
+            self,
+            &fold,
+            &contact,
+            frames.thigh,
+            gap,
+            &mut sc.skin_limits,
+        );
         // The fold of the rest shape is valid: the fallback of the guard below.
         knee_fold::fold_hexes(
             &fold,
@@ -458,14 +479,14 @@ impl Tissue {
                 };
             }
         }
-        let targets = &sc.muscle_targets;
+        let (targets, limits) = (&sc.muscle_targets, &sc.skin_limits);
         self.apply_muscles(targets);
-        self.apply_contact(&contact, gap);
+        self.apply_contact(&contact, gap, limits);
         let k = self.config.stiffness as f32;
         for _ in 0..self.config.iterations {
             self.fat.iterate(k);
             self.apply_muscles(targets);
-            self.apply_contact(&contact, gap);
+            self.apply_contact(&contact, gap, limits);
         }
         phases.shape_matching_s = lap.lap();
         let pose = |b: BodyId| match b {
@@ -479,7 +500,7 @@ impl Tissue {
             &fixed.bones,
             pose,
         );
-        self.apply_contact(&contact, gap);
+        self.apply_contact(&contact, gap, &sc.skin_limits);
         self.theta = theta;
         self.scratch = sc;
         phases.bone_sliding_s = lap.lap();
@@ -497,26 +518,6 @@ impl Tissue {
         for &(v, target) in targets {
             let cur = self.fat.x[v as usize];
             self.fat.x[v as usize] = cur + (target - cur) * PULL;
-        }
-    }
-
-    /// Keeps thigh-side and calf-side fat apart behind the knee ([`Contact`]).
-    fn apply_contact(&mut self, c: &Contact, gap: f32) {
-        let l1 = self.layers + 1;
-        for &v in &self.fixed.posterior {
-            let v = v as usize;
-            // Vertices outside the relaxed region sit on the fold, which keeps its side.
-            if !self.fat.free[v] {
-                continue;
-            }
-            // Deeper layers stop further from the contact, so squeezed elements stay
-            // thin but never flat.
-            let depth = (self.layers - v % l1) as f32;
-            self.fat.x[v] = c.apply(
-                self.fat.x[v],
-                self.fixed.thigh_side[v],
-                gap + LAYER_GAP * depth,
-            );
         }
     }
 

@@ -1,0 +1,92 @@
+//! The crease behind the knee: thigh-side and calf-side fat kept apart by the contact
+//! plane, and the skin there kept from drawing back from it.
+//!
+//! The knee fold spreads the posterior compression of a deep flexion over a wide sector,
+//! so it carries the skin of the back of the thigh and calf toward the front, away from
+//! the plane (at 134°, 10–13 cm above the axis, 40–50 mm), while the muscles under that
+//! skin stay with their bones: they came out through it. The skin behind the knee now
+//! lies no further from the plane, on its own side, than its bone alone would carry it,
+//! and where its bone would carry it past the plane (thigh and calf pressing on each
+//! other) it lies on the plane: the two sides meet there, over the muscles between.
+
+use glam::{Quat, Vec3};
+
+use super::knee_fold::{Contact, KneeFold};
+use super::{LAYER_GAP, Tissue};
+
+/// Skin vertices behind the knee (rest), each with how far (m) from the contact plane,
+/// on its side, it may lie now (where its bone alone carries it, but no nearer than
+/// `gap`, the skin's own margin), and how much of the way back it is pulled: the share
+/// of its outward direction (its rest column, turned with its bone) that faces the
+/// plane. Skin at the sides of the knee, which runs across the plane, is not pulled
+/// along itself: pulled whole, it folded over (379 crossing triangle pairs in the
+/// guard's first round of an update, against 116).
+///
+/// `fold` is the knee at this update, `contact` its plane (world) and `thigh` the thigh's
+/// pose.
+pub(super) fn skin_limits(
+    tissue: &Tissue,
+    fold: &KneeFold,
+    contact: &Contact,
+    (tq, tt): (Quat, Vec3),
+    gap: f32,
+    out: &mut Vec<(f32, f32)>,
+) {
+    let (fixed, rest, layers) = (&tissue.fixed, &tissue.fat.rest, tissue.layers);
+    let shank = Quat::from_axis_angle(fold.axis, fold.theta);
+    out.clear();
+    out.extend(fixed.posterior_skin.iter().map(|&v| {
+        let (r, thigh) = (rest[v as usize], fixed.thigh_side[v as usize]);
+        let rigid = if thigh {
+            tq * r + tt
+        } else {
+            tq * (fold.point + shank * (r - fold.point)) + tt
+        };
+        let s = if thigh { 1.0 } else { -1.0 };
+        let d = (rigid - contact.point).dot(contact.normal) * s;
+        // Skin vertices are the last of their radial column (`FatLattice::vertex_index`).
+        let col = r - rest[v as usize - layers];
+        let col = if thigh { tq * col } else { tq * (shank * col) };
+        let w = (-col.normalize_or_zero().dot(contact.normal) * s).max(0.0);
+        (d.max(gap), w)
+    }));
+}
+
+impl Tissue {
+    /// Keeps thigh-side and calf-side fat apart behind the knee ([`Contact`]), and pulls
+    /// the skin there back toward the plane as far as `limits` say (see
+    /// [`skin_limits`]).
+    pub(super) fn apply_contact(&mut self, c: &Contact, gap: f32, limits: &[(f32, f32)]) {
+        let l1 = self.layers + 1;
+        let fixed = &self.fixed;
+        let x = &mut self.fat.x;
+        for &v in &fixed.posterior {
+            let v = v as usize;
+            // Vertices outside the relaxed region sit on the fold, which keeps its side.
+            if !self.fat.free[v] {
+                continue;
+            }
+            // Deeper layers stop further from the contact, so squeezed elements stay
+            // thin but never flat.
+            let depth = (self.layers - v % l1) as f32;
+            x[v] = c.apply(x[v], fixed.thigh_side[v], gap + LAYER_GAP * depth);
+        }
+        // Only pulls toward the plane, to no less than `gap` from it: the push above
+        // holds the other bound.
+        for (&v, &(limit, w)) in fixed.posterior_skin.iter().zip(limits) {
+            let v = v as usize;
+            if !self.fat.free[v] {
+                continue;
+            }
+            let rel = x[v] - c.point;
+            if rel.dot(c.behind) <= 0.0 {
+                continue;
+            }
+            let s = if fixed.thigh_side[v] { 1.0 } else { -1.0 };
+            let d = rel.dot(c.normal) * s;
+            if d > limit {
+                x[v] -= c.normal * (s * (d - limit) * w);
+            }
+        }
+    }
+}
