@@ -1,13 +1,16 @@
 //! The crease behind the knee: thigh-side and calf-side fat kept apart by the contact
-//! plane, and the skin there kept from drawing back from it.
+//! plane, and the skin there drawn back toward it.
 //!
 //! The knee fold spreads the posterior compression of a deep flexion over a wide sector,
 //! so it carries the skin of the back of the thigh and calf toward the front, away from
 //! the plane (at 134°, 10–13 cm above the axis, 40–50 mm), while the muscles under that
-//! skin stay with their bones: they came out through it. The skin behind the knee now
-//! lies no further from the plane, on its own side, than its bone alone would carry it,
-//! and where its bone would carry it past the plane (thigh and calf pressing on each
-//! other) it lies on the plane: the two sides meet there, over the muscles between.
+//! skin stay with their bones: they came out through it. Each contact pass now pulls the
+//! skin behind the knee that lies further from the plane, on its own side, than its bone
+//! alone would carry it back toward that (toward the plane itself where its bone would
+//! carry it past it: the thigh and calf press on each other there), by a share of the
+//! excess: the share of its outward direction that faces the plane, nothing at the
+//! crease's apex. Over an update's passes the two sides come to meet on the plane, over
+//! the muscles between.
 
 use glam::{Quat, Vec3};
 
@@ -18,17 +21,18 @@ use super::{LAYER_GAP, Tissue};
 /// next [`APEX_RAMP_M`] the pull grows to its full share: at the crease's apex the skin
 /// turns round the axis, and pulled there it folded over itself (116 crossing triangle
 /// pairs and 83 elements below their volume floor in the guard's first round of an
-/// update, against 59 and 58; the most muscle vertices out, 1 769 and 1 995 against
-/// 1 842 and 2 024).
+/// update, against 59 and 58 with the apex spared). Sparing it costs a little cover:
+/// the most muscle vertices out went 1 769 → 1 842 (phantom) and 1 995 → 2 024 (Visible
+/// Human), for a cheaper guard.
 const APEX_M: f32 = 0.05;
 /// See [`APEX_M`].
 const APEX_RAMP_M: f32 = 0.03;
 
-/// Skin vertices behind the knee (rest), each with how far (m) from the contact plane,
-/// on its side, it may lie now (where its bone alone carries it, but no nearer than
-/// `gap`, the skin's own margin), and how much of the way back it is pulled: the share
-/// of its outward direction (its rest column, turned with its bone) that faces the
-/// plane. Skin at the sides of the knee, which runs across the plane, is not pulled
+/// Skin vertices behind the knee axis (rest), each with how far (m) from the contact
+/// plane, on its side, it may lie now before it is pulled (where its bone alone carries
+/// it, but no nearer than `gap`, the skin's own margin), and the share of the excess
+/// each contact pass removes: the share of its outward direction (its rest column,
+/// turned with its bone) that faces the plane. Skin at the sides of the knee, which runs across the plane, is not pulled
 /// along itself: pulled whole, it folded over (379 crossing triangle pairs in the
 /// guard's first round of an update, against 116).
 ///
@@ -64,8 +68,8 @@ pub(super) fn skin_limits(
 
 impl Tissue {
     /// Keeps thigh-side and calf-side fat apart behind the knee ([`Contact`]), and pulls
-    /// the skin there back toward the plane as far as `limits` say (see
-    /// [`skin_limits`]).
+    /// the skin there back toward the plane by the shares `limits` give (see
+    /// [`skin_limits`]; spared at the crease's apex, see [`APEX_M`]).
     pub(super) fn apply_contact(&mut self, c: &Contact, gap: f32, limits: &[(f32, f32)]) {
         let l1 = self.layers + 1;
         let fixed = &self.fixed;
@@ -83,6 +87,7 @@ impl Tissue {
         }
         // Only pulls toward the plane, to no less than `gap` from it: the push above
         // holds the other bound.
+        debug_assert_eq!(fixed.posterior_skin.len(), limits.len());
         for (&v, &(limit, w)) in fixed.posterior_skin.iter().zip(limits) {
             let v = v as usize;
             if !self.fat.free[v] {

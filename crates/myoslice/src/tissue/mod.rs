@@ -77,8 +77,9 @@ struct TissueStatic {
     thigh_side: Vec<bool>,
     /// Fat vertices behind the knee axis at rest (the contact acts there).
     posterior: Vec<u32>,
-    /// The skin's among them (kept from drawing back from the contact plane, see
-    /// [`crease`]).
+    /// The skin's among them, the whole length of the lattice: drawn back toward the
+    /// contact plane wherever it lies further from it than its bone alone would carry it
+    /// (see [`crease`]), which happens mostly near the knee, where the fold moves it.
     posterior_skin: Vec<u32>,
     /// Body-surface triangles near the knee, checked for crossings after each update.
     guard_triangles: Vec<[u32; 3]>,
@@ -119,7 +120,8 @@ struct Scratch {
     /// Where each inner vertex facing a muscle is pulled this update.
     muscle_targets: Vec<(u32, Vec3)>,
     /// How far from the contact plane each skin vertex behind the knee may lie this
-    /// update, and how much of the way back it is pulled ([`crease::skin_limits`]).
+    /// update before it is pulled, and the share of the excess a pass removes
+    /// ([`crease::skin_limits`]).
     skin_limits: Vec<(f32, f32)>,
     guard: Guard,
 }
@@ -231,12 +233,12 @@ impl Tissue {
         let fixed = TissueStatic {
             muscle_ref,
             thigh_side: fat.vertices.iter().map(|p| p.z >= kz).collect(),
-            posterior: posterior.clone(),
             posterior_skin: posterior
                 .iter()
                 .copied()
                 .filter(|&v| v as usize % (fat.layers + 1) == fat.layers)
                 .collect(),
+            posterior,
             guard_triangles,
             zone: FoldZone::new(&knee, &fat.vertices, &fat.hexes),
             bone_meshes,
