@@ -175,6 +175,9 @@ pub(crate) struct BoneKeepOut {
     /// Work buffer: the last shift bones alone asked of each ring this update (zero if
     /// none; the contact plane may not push against it).
     bone_push: Vec<Vec3>,
+    /// The body the shape is carried rigidly with this update, if it is (see
+    /// [`Self::clear_carried_rings`]).
+    carried_by: Option<BodyId>,
 }
 
 /// What a [`BoneKeepOut`] carries from one update to the next: the rings' shifts and what
@@ -273,12 +276,18 @@ impl BoneKeepOut {
             against: vec![0.0; rings],
             moved: vec![Vec3::ZERO; rings],
             bone_push: vec![Vec3::ZERO; rings],
+            carried_by: None,
         }
     }
 
     /// Lets the shifts fade by `keep` (a bone that has left no longer holds the rings off).
     pub(crate) fn fade(&mut self, keep: f32) {
         self.shift.iter_mut().for_each(|s| *s *= keep);
+    }
+
+    /// Whether any vertex is kept on its side of the contact plane.
+    pub(crate) fn near_plane(&self) -> bool {
+        !self.plane.is_empty()
     }
 
     /// Forgets every shift (the shape is back at rest on one body).
@@ -317,6 +326,23 @@ impl BoneKeepOut {
             }
             last = deep;
         }
+        &self.moved
+    }
+
+    /// [`Self::clear_rings`] for a shape carried rigidly by `body`: a ring without a shift
+    /// sits on that body's bones where it sat at rest, clear of them, so only the other
+    /// body's bones, the contact plane and the shifted rings need looking at.
+    pub(crate) fn clear_carried_rings(
+        &mut self,
+        current: &mut [Vec3],
+        ring_of: &[u32],
+        axis: impl Fn(usize) -> Vec3,
+        bones: &Bones,
+        body: BodyId,
+    ) -> &[Vec3] {
+        self.carried_by = Some(body);
+        self.clear_rings(current, ring_of, axis, bones);
+        self.carried_by = None;
         &self.moved
     }
 
@@ -389,13 +415,18 @@ impl BoneKeepOut {
         self.pushes.clear();
         let mut deep: Option<f32> = None;
         for (&(v, b), w) in self.pairs.iter().zip(&mut self.watch) {
-            if again && self.spread[ring_of[v as usize] as usize] == Vec3::ZERO {
+            let r = ring_of[v as usize] as usize;
+            if again && self.spread[r] == Vec3::ZERO {
+                continue;
+            }
+            if self.carried_by == Some(bones.meshes[b as usize].body())
+                && self.shift[r] == Vec3::ZERO
+            {
                 continue;
             }
             let Some(d) = bones.depth(b as usize, current[v as usize], w) else {
                 continue;
             };
-            let r = ring_of[v as usize] as usize;
             let (pushes, need) = (&mut self.pushes, &mut self.need);
             Self::add_push(pushes, need, r, d, axis(r), &mut deep, false);
         }

@@ -201,3 +201,56 @@ fn rings_past_the_contact_plane_go_back_to_their_side_and_rings_across_it_at_res
     let moved = run(&mut keep, &rest, &ring_of, &bones(steep), 20);
     assert!(moved == 0.0, "moved {:.1} mm", moved * 1e3);
 }
+
+#[test]
+fn carried_rings_find_what_fully_checked_rings_find() {
+    // Rings (radius 15 mm) carried by the thigh, 5 mm clear of a thigh bone on +x and
+    // of a shank bone on −x at rest; the shank then moves 12 mm along +x, 7 mm into
+    // them, and pushes them into the thigh's bone, which pushes back. Skipping the
+    // thigh bone's checks of rings not yet shifted must change nothing.
+    let span = |x0: f32, x1: f32| box_bone(Vec3::new(x0, -0.03, -0.01), Vec3::new(x1, 0.03, 0.02));
+    let bones = [span(0.02, 0.045), (BodyId::Shank, span(-0.045, -0.02).1)];
+    let meshes: Vec<BoneMesh> = bones.iter().map(|(b, m)| BoneMesh::new(*b, m)).collect();
+    let frames = BodyFrames {
+        shank: (Quat::IDENTITY, Vec3::new(0.012, 0.0, 0.0)),
+        ..BodyFrames::REST
+    };
+    let b = Bones {
+        meshes: &meshes,
+        surfaces: &bones,
+        frames: &frames,
+        fade: fade_per_update(30.0),
+        contact: None,
+    };
+    let (rest, ring_of) = rings(0.015, 0.015, 0.0);
+    let fresh = || BoneKeepOut::new(&rest, RINGS, &bones, &meshes, &far_contact());
+    let (mut carried, mut full) = (fresh(), fresh());
+    assert!(
+        carried.pairs.iter().any(|&(_, b)| b == 0) && carried.pairs.iter().any(|&(_, b)| b == 1),
+        "both bones watched"
+    );
+    for _ in 0..10 {
+        for (keep, own) in [(&mut carried, Some(BodyId::Thigh)), (&mut full, None)] {
+            keep.fade(b.fade);
+            let mut current: Vec<Vec3> = rest
+                .iter()
+                .zip(&ring_of)
+                .map(|(p, &r)| *p + keep.shift[r as usize])
+                .collect();
+            match own {
+                Some(body) => {
+                    keep.clear_carried_rings(&mut current, &ring_of, |_| Vec3::Z, &b, body);
+                }
+                None => {
+                    keep.clear_rings(&mut current, &ring_of, |_| Vec3::Z, &b);
+                }
+            }
+        }
+        assert_eq!(carried.shift, full.shift);
+    }
+    assert!(
+        full.shift.iter().all(|s| s.x > 0.005),
+        "the shank's bone pushed the rings {:?}",
+        full.shift
+    );
+}
