@@ -31,7 +31,7 @@ const HALVING_ROUNDS: usize = 32;
 const GIVE_BACK: f32 = 0.5;
 /// ...and a vertex found bad again at or below this share takes its place in the fold.
 /// (Sent to the fold at once, the crease's skin lost the muscles it had followed out:
-/// more muscle vertices out through it at deep flexion, see the README.)
+/// more muscle vertices out through it at deep flexion, see docs/tissue-history.md.)
 const LAST_SHARE: f32 = 0.2;
 
 /// Marks vertex `i` bad, listing it the first time.
