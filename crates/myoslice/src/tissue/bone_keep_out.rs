@@ -175,9 +175,9 @@ pub(crate) struct BoneKeepOut {
     /// Work buffer: the last shift bones alone asked of each ring this update (zero if
     /// none; the contact plane may not push against it).
     bone_push: Vec<Vec3>,
-    /// The body the shape is carried rigidly with this update, if it is (see
-    /// [`Self::clear_carried_rings`]).
-    carried_by: Option<BodyId>,
+    /// Checks [`Self::clear_carried_rings`] skipped (tests only).
+    #[cfg(test)]
+    skipped: usize,
 }
 
 /// What a [`BoneKeepOut`] carries from one update to the next: the rings' shifts and what
@@ -276,13 +276,21 @@ impl BoneKeepOut {
             against: vec![0.0; rings],
             moved: vec![Vec3::ZERO; rings],
             bone_push: vec![Vec3::ZERO; rings],
-            carried_by: None,
+            #[cfg(test)]
+            skipped: 0,
         }
     }
 
     /// Lets the shifts fade by `keep` (a bone that has left no longer holds the rings off).
     pub(crate) fn fade(&mut self, keep: f32) {
-        self.shift.iter_mut().for_each(|s| *s *= keep);
+        for s in &mut self.shift {
+            *s *= keep;
+            // Below a tenth of a micrometre a shift is gone: multiplied on, it would stay
+            // a few subnormal units for half a minute, and its ring count as shifted.
+            if s.length_squared() < 1e-14 {
+                *s = Vec3::ZERO;
+            }
+        }
     }
 
     /// Whether any vertex is kept on its side of the contact plane.
@@ -290,7 +298,8 @@ impl BoneKeepOut {
         !self.plane.is_empty()
     }
 
-    /// Forgets every shift (the shape is back at rest on one body).
+    /// Forgets every shift (the shape is carried at rest on one body, away from the
+    /// contact plane).
     pub(crate) fn clear(&mut self) {
         self.shift.iter_mut().for_each(|s| *s = Vec3::ZERO);
     }
@@ -305,12 +314,40 @@ impl BoneKeepOut {
         axis: impl Fn(usize) -> Vec3,
         bones: &Bones,
     ) -> &[Vec3] {
+        self.clear_rings_of(current, ring_of, axis, bones, None)
+    }
+
+    /// [`Self::clear_rings`] for a shape carried rigidly by `body`: the caller has placed
+    /// every ring where `body` carries its rest place, plus (across the ring) its shift.
+    /// A ring without a shift then sits on that body's bones where it sat at rest, clear
+    /// of them (pairs are only formed for vertices clear at rest), so only the other
+    /// body's bones, the contact plane and the shifted rings are looked at.
+    pub(crate) fn clear_carried_rings(
+        &mut self,
+        current: &mut [Vec3],
+        ring_of: &[u32],
+        axis: impl Fn(usize) -> Vec3,
+        bones: &Bones,
+        body: BodyId,
+    ) -> &[Vec3] {
+        self.clear_rings_of(current, ring_of, axis, bones, Some(body))
+    }
+
+    fn clear_rings_of(
+        &mut self,
+        current: &mut [Vec3],
+        ring_of: &[u32],
+        axis: impl Fn(usize) -> Vec3,
+        bones: &Bones,
+        carried: Option<BodyId>,
+    ) -> &[Vec3] {
         self.moved.clear();
         self.moved.resize(self.shift.len(), Vec3::ZERO);
         self.bone_push.iter_mut().for_each(|b| *b = Vec3::ZERO);
         let mut last = f32::INFINITY;
         for round in 0..PUSH_ROUNDS {
-            let Some(deep) = self.push_out(current, ring_of, &axis, bones, round > 0) else {
+            let again = round > 0;
+            let Some(deep) = self.push_out(current, ring_of, &axis, bones, again, carried) else {
                 break;
             };
             for (m, s) in self.moved.iter_mut().zip(&self.spread) {
@@ -326,23 +363,6 @@ impl BoneKeepOut {
             }
             last = deep;
         }
-        &self.moved
-    }
-
-    /// [`Self::clear_rings`] for a shape carried rigidly by `body`: a ring without a shift
-    /// sits on that body's bones where it sat at rest, clear of them, so only the other
-    /// body's bones, the contact plane and the shifted rings need looking at.
-    pub(crate) fn clear_carried_rings(
-        &mut self,
-        current: &mut [Vec3],
-        ring_of: &[u32],
-        axis: impl Fn(usize) -> Vec3,
-        bones: &Bones,
-        body: BodyId,
-    ) -> &[Vec3] {
-        self.carried_by = Some(body);
-        self.clear_rings(current, ring_of, axis, bones);
-        self.carried_by = None;
         &self.moved
     }
 
@@ -403,6 +423,9 @@ impl BoneKeepOut {
     ///
     /// `again` says the last call was this update's previous round: then only the
     /// vertices that call moved are looked at (the others would be found as they were).
+    /// `carried` names the body that carries the shape rigidly, if one does: then its
+    /// bones are not looked at for rings without a shift (see
+    /// [`Self::clear_carried_rings`]).
     fn push_out(
         &mut self,
         current: &mut [Vec3],
@@ -410,6 +433,7 @@ impl BoneKeepOut {
         axis: impl Fn(usize) -> Vec3,
         bones: &Bones,
         again: bool,
+        carried: Option<BodyId>,
     ) -> Option<f32> {
         self.need.iter_mut().for_each(|n| *n = Vec3::ZERO);
         self.pushes.clear();
@@ -419,9 +443,11 @@ impl BoneKeepOut {
             if again && self.spread[r] == Vec3::ZERO {
                 continue;
             }
-            if self.carried_by == Some(bones.meshes[b as usize].body())
-                && self.shift[r] == Vec3::ZERO
-            {
+            if carried == Some(bones.meshes[b as usize].body()) && self.shift[r] == Vec3::ZERO {
+                #[cfg(test)]
+                {
+                    self.skipped += 1;
+                }
                 continue;
             }
             let Some(d) = bones.depth(b as usize, current[v as usize], w) else {

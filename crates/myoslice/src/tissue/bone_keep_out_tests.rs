@@ -204,23 +204,23 @@ fn rings_past_the_contact_plane_go_back_to_their_side_and_rings_across_it_at_res
 
 #[test]
 fn carried_rings_find_what_fully_checked_rings_find() {
-    // Rings (radius 15 mm) carried by the thigh, 5 mm clear of a thigh bone on +x and
-    // of a shank bone on −x at rest; the shank then moves 12 mm along +x, 7 mm into
-    // them, and pushes them into the thigh's bone, which pushes back. Skipping the
-    // thigh bone's checks of rings not yet shifted must change nothing.
-    let span = |x0: f32, x1: f32| box_bone(Vec3::new(x0, -0.03, -0.01), Vec3::new(x1, 0.03, 0.02));
-    let bones = [span(0.02, 0.045), (BodyId::Shank, span(-0.045, -0.02).1)];
+    // Rings (radius 15 mm, z 0–8 mm) carried by the thigh, 2 mm clear at rest of a thigh
+    // bone on +x, and 5 mm clear of a shank bone on −x whose top (z 3 mm) reaches the
+    // first ring only. The shank then moves 7 mm along +x, 2 mm into that ring (its way
+    // out across the ring shorter than over the top), and pushes it (its neighbours
+    // following by shares) into the thigh's bone, which pushes back. Then the shank goes
+    // back and the shifts fade, ring by ring, to nothing, the thigh bone's checks of the
+    // rings already back skipped. The skips must change nothing.
+    let slab =
+        |x0: f32, x1: f32, z1: f32| box_bone(Vec3::new(x0, -0.03, -0.01), Vec3::new(x1, 0.03, z1));
+    let bones = [
+        slab(0.017, 0.045, 0.02),
+        (BodyId::Shank, slab(-0.045, -0.02, 0.003).1),
+    ];
     let meshes: Vec<BoneMesh> = bones.iter().map(|(b, m)| BoneMesh::new(*b, m)).collect();
-    let frames = BodyFrames {
-        shank: (Quat::IDENTITY, Vec3::new(0.012, 0.0, 0.0)),
+    let moved = BodyFrames {
+        shank: (Quat::IDENTITY, Vec3::new(0.007, 0.0, 0.0)),
         ..BodyFrames::REST
-    };
-    let b = Bones {
-        meshes: &meshes,
-        surfaces: &bones,
-        frames: &frames,
-        fade: fade_per_update(30.0),
-        contact: None,
     };
     let (rest, ring_of) = rings(0.015, 0.015, 0.0);
     let fresh = || BoneKeepOut::new(&rest, RINGS, &bones, &meshes, &far_contact());
@@ -229,7 +229,17 @@ fn carried_rings_find_what_fully_checked_rings_find() {
         carried.pairs.iter().any(|&(_, b)| b == 0) && carried.pairs.iter().any(|&(_, b)| b == 1),
         "both bones watched"
     );
-    for _ in 0..10 {
+    let mut deepest_shift = 0.0f32;
+    let mut skipped_pushed = 0;
+    for update in 0..160 {
+        let frames = if update < 10 { moved } else { BodyFrames::REST };
+        let b = Bones {
+            meshes: &meshes,
+            surfaces: &bones,
+            frames: &frames,
+            fade: fade_per_update(30.0),
+            contact: None,
+        };
         for (keep, own) in [(&mut carried, Some(BodyId::Thigh)), (&mut full, None)] {
             keep.fade(b.fade);
             let mut current: Vec<Vec3> = rest
@@ -246,11 +256,23 @@ fn carried_rings_find_what_fully_checked_rings_find() {
                 }
             }
         }
-        assert_eq!(carried.shift, full.shift);
+        assert_eq!(carried.shift, full.shift, "update {update}");
+        deepest_shift = deepest_shift.max(full.shift[0].x);
+        if update == 10 {
+            skipped_pushed = carried.skipped;
+        }
     }
     assert!(
-        full.shift.iter().all(|s| s.x > 0.005),
-        "the shank's bone pushed the rings {:?}",
+        deepest_shift > 0.002,
+        "the shank's bone pushed the first ring {:.1} mm",
+        deepest_shift * 1e3
+    );
+    // Checks were skipped while other rings' shifts were still fading, not only at rest.
+    assert!(carried.skipped > skipped_pushed && full.skipped == 0);
+    // Faded to nothing, not to a few subnormal units.
+    assert!(
+        full.shift.iter().all(|s| *s == Vec3::ZERO),
+        "{:?}",
         full.shift
     );
 }

@@ -50,9 +50,11 @@ impl Placing<'_> {
             .for_each(|(shape, m)| {
                 // A muscle resting on one body keeps its rest shape and moves with it
                 // (placed from its chain, such muscles came out more, 9 850 → 10 233);
-                // near the knee its rings are still shifted back to their side of the
-                // contact plane and out of the other body's bones (the phantom's
+                // one the contact plane watches is still shifted ring by ring back to
+                // its side of it and out of bone, as a placed one is (the phantom's
                 // peroneus longus: 158 → 25 vertices out through the skin at 134°).
+                // One it does not watch is carried alone, even where it could meet the
+                // other body's bones (none has been seen to).
                 let quiet = !m.crosses_knee && m.activation < 1e-4 && m.excitation == 0.0;
                 match m.chain.single_body() {
                     Some(b) if quiet => {

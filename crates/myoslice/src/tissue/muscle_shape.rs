@@ -294,7 +294,8 @@ impl MuscleShape {
         }
         // Shifted rings shear the surface between them, which changes its volume a
         // little (1.6 % for the phantom's peroneus longus at 134°): the cross-sections
-        // give it back, one factor per muscle, as in `place`.
+        // give it back, one factor per muscle, as in `place` (which likewise scales them
+        // after the keep-out: a fraction of a millimetre, unchecked).
         let centres: Vec<Vec3> = self
             .ring_param
             .iter()
