@@ -224,12 +224,11 @@ impl BoneKeepOut {
             // plane: in front, the plane turns away as the knee bends.
             .filter(|(_, p)| {
                 p.distance(knee) < PLANE_REACH_M
-                    && (**p - rest_contact.point).dot(rest_contact.behind) > -PLANE_FRONT_M
+                    && rest_contact.locate(**p, true).0 > -PLANE_FRONT_M
             })
             .map(|(v, &p)| {
                 let thigh = p.z >= knee.z;
-                let d = (p - rest_contact.point).dot(rest_contact.normal);
-                (v as u32, if thigh { d } else { -d }, thigh)
+                (v as u32, rest_contact.locate(p, thigh).1, thigh)
             })
             .collect();
         let mut pairs = Vec::new();

@@ -56,12 +56,11 @@ pub(super) fn skin_limits(
         } else {
             tq * (fold.point + shank * (r - fold.point)) + tt
         };
-        let s = if thigh { 1.0 } else { -1.0 };
-        let d = (rigid - contact.point).dot(contact.normal) * s;
+        let (_, d) = contact.locate(rigid, thigh);
         // Skin vertices are the last of their radial column (`FatLattice::vertex_index`).
         let col = r - rest[v as usize - layers];
         let col = if thigh { tq * col } else { tq * (shank * col) };
-        let w = (-col.normalize_or_zero().dot(contact.normal) * s).max(0.0);
+        let w = (-contact.off_side(col.normalize_or_zero(), thigh)).max(0.0);
         (d.max(gap), w)
     }));
 }
@@ -93,16 +92,14 @@ impl Tissue {
             if !self.fat.free[v] {
                 continue;
             }
-            let rel = x[v] - c.point;
-            let behind = rel.dot(c.behind);
+            let thigh = fixed.thigh_side[v];
+            let (behind, d) = c.locate(x[v], thigh);
             if behind <= 0.0 {
                 continue;
             }
             let f = ((behind - APEX_M) / APEX_RAMP_M).clamp(0.0, 1.0);
-            let s = if fixed.thigh_side[v] { 1.0 } else { -1.0 };
-            let d = rel.dot(c.normal) * s;
             if d > limit {
-                x[v] -= c.normal * (s * (d - limit) * w * f);
+                x[v] = c.toward_side(x[v], thigh, -((d - limit) * w * f));
             }
         }
     }

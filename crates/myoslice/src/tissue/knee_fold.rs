@@ -415,17 +415,36 @@ impl Contact {
     /// Where `p` goes; `thigh` says which side it belongs to, `margin` (m) how far from
     /// the plane it stays.
     pub fn apply(&self, p: Vec3, thigh: bool, margin: f32) -> Vec3 {
-        let rel = p - self.point;
-        if rel.dot(self.behind) <= 0.0 {
+        let (behind, d) = self.locate(p, thigh);
+        if behind <= 0.0 {
             return p;
         }
-        let s = if thigh { 1.0 } else { -1.0 };
-        let d = rel.dot(self.normal) * s;
         if d < margin {
-            p + self.normal * (s * (margin - d))
+            self.toward_side(p, thigh, margin - d)
         } else {
             p
         }
+    }
+
+    /// How far `p` lies behind the knee axis (along [`Self::behind`]) and how far from
+    /// the plane on the side `thigh` names (the thigh's, or the calf's; negative past
+    /// the plane).
+    pub fn locate(&self, p: Vec3, thigh: bool) -> (f32, f32) {
+        let rel = p - self.point;
+        (rel.dot(self.behind), self.off_side(rel, thigh))
+    }
+
+    /// The part of `v` along the plane's normal that points away from the plane on the
+    /// side `thigh` names.
+    pub fn off_side(&self, v: Vec3, thigh: bool) -> f32 {
+        let d = v.dot(self.normal);
+        if thigh { d } else { -d }
+    }
+
+    /// `p` moved `by` (m) along the plane's normal, away from the plane on the side
+    /// `thigh` names (toward it, where `by` is negative).
+    pub fn toward_side(&self, p: Vec3, thigh: bool, by: f32) -> Vec3 {
+        p + self.normal * if thigh { by } else { -by }
     }
 }
 

@@ -249,10 +249,9 @@ impl MuscleShape {
             // one factor per muscle, the square root of the volume ratio.
             let v = volume_about(&self.current, &self.triangles, origin);
             self.volume_now = v;
-            let fix = ((self.rest_volume / v.max(1e-15)) as f32).sqrt();
-            if (fix - 1.0).abs() < 2e-4 || pass + 1 == VOLUME_PASSES || v <= 0.0 {
+            let Some(fix) = volume_fix(self.rest_volume, v, pass) else {
                 break;
-            }
+            };
             across_fix *= fix;
         }
     }
@@ -310,10 +309,9 @@ impl MuscleShape {
         for pass in 0..VOLUME_PASSES {
             let v = volume_about(&self.current, &self.triangles, origin);
             self.volume_now = v;
-            let fix = ((self.rest_volume / v.max(1e-15)) as f32).sqrt();
-            if (fix - 1.0).abs() < 2e-4 || pass + 1 == VOLUME_PASSES || v <= 0.0 {
+            let Some(fix) = volume_fix(self.rest_volume, v, pass) else {
                 break;
-            }
+            };
             for (p, &ring) in self.current.iter_mut().zip(&self.ring_of) {
                 let (c, a) = (centres[ring as usize], axes[ring as usize]);
                 let o = *p - c;
@@ -332,6 +330,16 @@ impl MuscleShape {
     pub fn volume(&self) -> f64 {
         signed_volume(&self.current, &self.triangles).abs()
     }
+}
+
+/// The factor by which volume pass `pass` scales the cross-sections of a shape that
+/// encloses `v` (m³) against `rest`: the square root of the volume ratio. None when the
+/// shape is close enough (within 2 × 10⁻⁴ of that factor), out of passes, or not a
+/// volume at all.
+fn volume_fix(rest: f64, v: f64, pass: usize) -> Option<f32> {
+    let fix = ((rest / v.max(1e-15)) as f32).sqrt();
+    let done = (fix - 1.0).abs() < 2e-4 || pass + 1 == VOLUME_PASSES || v <= 0.0;
+    (!done).then_some(fix)
 }
 
 /// Enclosed volume (m³) of a closed triangle surface, summed about `origin` in single
