@@ -538,7 +538,8 @@ fn muscles_stepping_beside_the_guard_give_the_same_bits_as_one_after_the_other()
 /// on the Visible Human; without the contact plane on muscles either, 2 237 and 2 207).
 /// The most at one update and the farthest hold the skin kept from drawing back from the
 /// plane (without: 9 022 and 8 815 vertices, 39.7 and 39.6 mm; with the plane's reach
-/// for muscles at 12 cm too, 44.9 and 45.2 mm).
+/// for muscles at 12 cm too, 44.9 and 45.2 mm), and the muscles kept under the skin that
+/// faces the plane (without: 1 821 and 2 004 vertices at 117°, 19.2 and 22.3 mm).
 fn muscles_reach_out_no_further_than_recorded(mut sim: Simulation) {
     let (mut most, mut below_70, mut farthest, mut rising_45) = (0usize, 0usize, 0.0f32, 0.0f32);
     let mut top = 0.0f64;
@@ -569,7 +570,7 @@ fn muscles_reach_out_no_further_than_recorded(mut sim: Simulation) {
     );
     eprintln!("{summary}");
     assert!(
-        rising_45 < 0.006 && most < 2_500 && below_70 < 600 && farthest < 0.025,
+        rising_45 < 0.006 && most < 1_600 && below_70 < 600 && farthest < 0.020,
         "{summary}"
     );
 }

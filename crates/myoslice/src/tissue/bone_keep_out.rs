@@ -17,6 +17,7 @@ use parry3d::shape::TriMesh;
 
 use super::bone_slide::BoneMesh;
 use super::knee_fold::Contact;
+use super::skin_cover::SkinCover;
 use crate::body::BodyId;
 use crate::muscle::BodyFrames;
 
@@ -64,6 +65,8 @@ pub(crate) struct Bones<'a> {
     pub(crate) fade: f32,
     /// The contact plane behind the knee (world), which muscles keep their side of.
     pub(crate) contact: Option<Contact>,
+    /// How near the plane the skin over it lies, which muscles keep under.
+    pub(crate) cover: Option<&'a SkinCover>,
 }
 
 /// Share of a ring's shift kept from one update to the next at `rate_hz` updates a second:
@@ -469,8 +472,11 @@ impl BoneKeepOut {
                     continue;
                 }
                 let p = current[v as usize];
-                let d = (c.apply(p, thigh, c.muscle_margin.min(rest_d)) - p)
-                    .clamp_length_max(PLANE_STEP_M);
+                let mut margin = c.muscle_margin.min(rest_d);
+                if let Some(cover) = bones.cover {
+                    margin = margin.max(cover.floor(p, thigh));
+                }
+                let d = (c.apply(p, thigh, margin) - p).clamp_length_max(PLANE_STEP_M);
                 if d != Vec3::ZERO && d.dot(self.bone_push[r]) >= 0.0 {
                     let (pushes, need) = (&mut self.pushes, &mut self.need);
                     Self::add_push(pushes, need, r, d, axis(r), &mut deep, true);

@@ -94,6 +94,7 @@ fn a_ring_a_bone_reaches_into_from_opposite_sides_is_not_pushed_away() {
         frames: &frames,
         fade: fade_per_update(30.0),
         contact: None,
+        cover: None,
     };
     let (rest, ring_of) = rings(0.015, 0.015, 0.0);
     let fresh = || BoneKeepOut::new(&rest, RINGS, &bones, &meshes, &far_contact());
@@ -136,6 +137,7 @@ fn rings_past_the_contact_plane_go_back_to_their_side_and_rings_across_it_at_res
         frames: &frames,
         fade: fade_per_update(30.0),
         contact: Some(contact),
+        cover: None,
     };
     // Thigh-side rings (z 10–18 mm) of radius 10 mm round y = 4 mm; the plane turned
     // 45° into the thigh behind the knee reaches 2.8 mm past their back.
@@ -239,6 +241,7 @@ fn carried_rings_find_what_fully_checked_rings_find() {
             frames: &frames,
             fade: fade_per_update(30.0),
             contact: None,
+            cover: None,
         };
         for (keep, own) in [(&mut carried, Some(BodyId::Thigh)), (&mut full, None)] {
             keep.fade(b.fade);

@@ -19,6 +19,7 @@ pub mod muscle_shape;
 mod phases;
 pub mod polar;
 mod skin_breach;
+mod skin_cover;
 mod tissue_backup;
 mod tissue_config;
 mod update_back;
@@ -81,6 +82,9 @@ struct TissueStatic {
     /// contact plane wherever it lies further from it than its bone alone would carry it
     /// (see [`crease`]), which happens mostly near the knee, where the fold moves it.
     posterior_skin: Vec<u32>,
+    /// Rest position, outward direction (its radial column's) and side (thigh or not)
+    /// of each of [`Self::posterior_skin`].
+    posterior_skin_rest: Vec<(Vec3, Vec3, bool)>,
     /// Body-surface triangles near the knee, checked for crossings after each update.
     guard_triangles: Vec<[u32; 3]>,
     /// Where the knee fold can bend the fat.
@@ -230,14 +234,23 @@ impl Tissue {
         let posterior: Vec<u32> = (0..nv as u32)
             .filter(|&v| fold.is_posterior(fat.vertices[v as usize]))
             .collect();
+        let posterior_skin: Vec<u32> = posterior
+            .iter()
+            .copied()
+            .filter(|&v| v as usize % (fat.layers + 1) == fat.layers)
+            .collect();
         let fixed = TissueStatic {
             muscle_ref,
-            thigh_side: fat.vertices.iter().map(|p| p.z >= kz).collect(),
-            posterior_skin: posterior
+            posterior_skin_rest: posterior_skin
                 .iter()
-                .copied()
-                .filter(|&v| v as usize % (fat.layers + 1) == fat.layers)
+                .map(|&v| {
+                    let p = fat.vertices[v as usize];
+                    let col = p - fat.vertices[v as usize - fat.layers];
+                    (p, col.normalize_or_zero(), p.z >= kz)
+                })
                 .collect(),
+            thigh_side: fat.vertices.iter().map(|p| p.z >= kz).collect(),
+            posterior_skin,
             posterior,
             guard_triangles,
             zone: FoldZone::new(&knee, &fat.vertices, &fat.hexes),
@@ -296,6 +309,7 @@ impl Tissue {
             frames,
             fade: 1.0,
             contact: None,
+            cover: None,
         };
         let crossed = self.fixed.bones_crossed.get_or_init(|| {
             self.fixed

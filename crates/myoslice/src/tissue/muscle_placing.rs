@@ -11,6 +11,7 @@ use rayon::prelude::*;
 
 use super::bone_keep_out::{self, Bones};
 use super::knee_fold::{Contact, KneeFold};
+use super::skin_cover::SkinCover;
 use super::{LAYER_GAP, MuscleShape, TissueConfig, TissueStatic};
 use crate::body::{BodyId, KneeAxis};
 use crate::muscle::{BodyFrames, MuscleUnit};
@@ -37,12 +38,20 @@ impl Placing<'_> {
         // Muscles are not squashed onto the contact plane (their volume is the invariant
         // kept; the fat over them is): bones push them aside ring by ring, and the plane
         // pushes whole rings back to their side of it, a little each round.
+        let cover = SkinCover::new(
+            &self.fixed.posterior_skin_rest,
+            &fold,
+            &contact,
+            frames.thigh,
+            LAYER_GAP * (self.layers as f32 + 1.0),
+        );
         let bones = Bones {
             meshes: &self.fixed.bone_meshes,
             surfaces: &self.fixed.bones,
             frames,
             fade: bone_keep_out::fade_per_update(self.config.rate_hz),
             contact: Some(contact),
+            cover: Some(&cover),
         };
         self.shapes
             .par_iter_mut()
