@@ -283,7 +283,7 @@ fn muscles_are_kept_out_of_bone_through_a_deep_flexion() {
     // straddle a bone shifted by their largest push, 14.7 mm deep; with the contact plane
     // pushing rings as far as it wanted at once, 595 vertices, 19 mm; with the rounds
     // stopped by the count of vertices over 1 mm in, not by their depth, and at most 8 of
-    // them, 215 vertices, 9.5 mm (now 142, 7.7 mm).
+    // them, 215 vertices, 9.5 mm (now 160, 7.7 mm).
     assert!(
         added < 200 && deepest < 0.009,
         "{added} more muscle vertices than at rest > 1 mm inside bone, the deepest {:.1} mm",

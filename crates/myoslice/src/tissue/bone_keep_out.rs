@@ -160,7 +160,8 @@ pub(crate) struct BoneKeepOut {
     watch: Vec<Watch>,
     /// Vertices near the knee kept on their side of the contact plane: (vertex, how far
     /// on its side it was at rest (m, negative past it), whether the side is the
-    /// thigh's). None need keep further from the plane than at rest.
+    /// thigh's). None need keep further from the plane than at rest, unless the skin over
+    /// it is further ([`Bones::cover`]).
     plane: Vec<(u32, f32, bool)>,
     /// Shift of each ring (world, m).
     pub(crate) shift: Vec<Vec3>,
@@ -413,12 +414,13 @@ impl BoneKeepOut {
         *deep = Some(deep.unwrap_or(0.0) + if depth > 1e-3 { depth } else { 0.0 });
     }
 
-    /// Finds the rings a bone reaches into or that lie past the contact plane, shifts
+    /// Finds the rings a bone reaches into or that lie nearer the contact plane than they
+    /// keep (its margin, or the floor of the skin over them, [`Bones::cover`]), shifts
     /// them out (a neighbour as far as the largest of [`SPREAD`]'s shares of the rings
     /// near it, so the surface bends rather than steps) and moves their vertices in
     /// `current` with them. Returns how far (m) the vertices found more than 1 mm in
-    /// bone or past the plane were in, summed (zero when none was that far), None when
-    /// none was found at all.
+    /// bone or nearer the plane than they keep were in, summed (zero when none was that
+    /// far), None when none was found at all.
     ///
     /// A ring moves across its muscle only (`axis` gives each ring's direction): moved
     /// along, it would slide into its neighbours and crease the surface.

@@ -1,6 +1,8 @@
 //! Tests of the keep-out from bone and the contact plane ([`super::BoneKeepOut`]).
 
 use super::*;
+use crate::body::KneeAxis;
+use crate::tissue::knee_fold::KneeFold;
 
 /// A contact plane, and so a knee point, far from the test's rings.
 fn far_contact() -> Contact {
@@ -121,16 +123,30 @@ fn a_ring_a_bone_reaches_into_from_opposite_sides_is_not_pushed_away() {
     }
 }
 
-#[test]
-fn rings_past_the_contact_plane_go_back_to_their_side_and_rings_across_it_at_rest_stay() {
-    // No bone; the knee at the origin, the rest plane level (z up, behind +y).
-    let frames = BodyFrames::REST;
-    let rest_plane = Contact {
+/// The knee at the origin, the rest plane level (z up, behind +y), a 1 mm margin.
+fn level_plane() -> Contact {
+    Contact {
         point: Vec3::ZERO,
         normal: Vec3::Z,
         behind: Vec3::Y,
         muscle_margin: 0.001,
-    };
+    }
+}
+
+/// [`level_plane`] turned 45° into the thigh behind the knee.
+fn turned_plane() -> Contact {
+    Contact {
+        normal: Vec3::new(0.0, -1.0, 1.0).normalize(),
+        behind: Vec3::new(0.0, 1.0, 1.0).normalize(),
+        ..level_plane()
+    }
+}
+
+#[test]
+fn rings_past_the_contact_plane_go_back_to_their_side_and_rings_across_it_at_rest_stay() {
+    // No bone.
+    let frames = BodyFrames::REST;
+    let rest_plane = level_plane();
     let bones = |contact| Bones {
         meshes: &[],
         surfaces: &[],
@@ -143,11 +159,7 @@ fn rings_past_the_contact_plane_go_back_to_their_side_and_rings_across_it_at_res
     // 45° into the thigh behind the knee reaches 2.8 mm past their back.
     let (rest, ring_of) = rings(0.01, 0.01, 0.01);
     let rest: Vec<Vec3> = rest.iter().map(|p| *p + Vec3::Y * 0.004).collect();
-    let turned = Contact {
-        normal: Vec3::new(0.0, -1.0, 1.0).normalize(),
-        behind: Vec3::new(0.0, 1.0, 1.0).normalize(),
-        ..rest_plane
-    };
+    let turned = turned_plane();
     let past = |keep: &BoneKeepOut| {
         rest.iter()
             .zip(&ring_of)
@@ -202,6 +214,65 @@ fn rings_past_the_contact_plane_go_back_to_their_side_and_rings_across_it_at_res
     let mut keep = BoneKeepOut::new(&rest, RINGS, &[], &[], &rest_plane);
     let moved = run(&mut keep, &rest, &ring_of, &bones(steep), 20);
     assert!(moved == 0.0, "moved {:.1} mm", moved * 1e3);
+}
+
+#[test]
+fn rings_under_skin_that_faces_the_plane_keep_beneath_it() {
+    // The rings and the plane turned 45° into the thigh of the test above, and thigh
+    // skin facing the plane 12 mm from it over their cells: the rings keep that far and
+    // the fat's depth (3 mm) more from the plane, not just the plane's 1 mm margin.
+    let frames = BodyFrames::REST;
+    let (rest_plane, turned) = (level_plane(), turned_plane());
+    let along = turned.normal.cross(turned.behind);
+    let skin: Vec<(Vec3, Vec3, bool)> = (0..12)
+        .flat_map(|i| (-6..6).map(move |j| (i, j)))
+        .map(|(i, j)| {
+            let p = turned.behind * (0.0025 + 0.005 * i as f32)
+                + along * (0.0025 + 0.005 * j as f32)
+                + turned.normal * 0.012;
+            (p, -turned.normal, true)
+        })
+        .collect();
+    let knee = KneeAxis {
+        point: Vec3::ZERO,
+        axis: Vec3::X,
+        condyle_radius: 0.02,
+    };
+    let cover = SkinCover::new(
+        &skin,
+        &KneeFold::new(&knee, 0.0),
+        &turned,
+        (Quat::IDENTITY, Vec3::ZERO),
+        0.003,
+    );
+    let (rest, ring_of) = rings(0.01, 0.01, 0.01);
+    let rest: Vec<Vec3> = rest.iter().map(|p| *p + Vec3::Y * 0.004).collect();
+    // How far any vertex behind the axis lies nearer the plane than its floor (m).
+    let under = |keep: &BoneKeepOut| {
+        rest.iter()
+            .zip(&ring_of)
+            .map(|(p, &r)| *p + keep.shift[r as usize])
+            .filter(|p| p.dot(turned.behind) > 0.0)
+            .map(|p| cover.floor(p, true) - p.dot(turned.normal))
+            .fold(f32::NEG_INFINITY, f32::max)
+    };
+    let with = |cover| Bones {
+        meshes: &[],
+        surfaces: &[],
+        frames: &frames,
+        fade: fade_per_update(30.0),
+        contact: Some(turned),
+        cover,
+    };
+    let mut plain = BoneKeepOut::new(&rest, RINGS, &[], &[], &rest_plane);
+    run(&mut plain, &rest, &ring_of, &with(None), 20);
+    assert!(under(&plain) > 0.01, "{:.1} mm", under(&plain) * 1e3);
+    let mut keep = BoneKeepOut::new(&rest, RINGS, &[], &[], &rest_plane);
+    run(&mut keep, &rest, &ring_of, &with(Some(&cover)), 20);
+    assert!(under(&keep) < 1e-4, "{:.1} mm under", under(&keep) * 1e3);
+    for s in &keep.shift {
+        assert!(s.z == 0.0 && s.y < 0.0, "{s:?}");
+    }
 }
 
 #[test]

@@ -20,17 +20,19 @@ use super::knee_fold::{Contact, KneeFold};
 const CELL_M: f32 = 0.01;
 /// Cells behind the knee axis (from the axis).
 const BEHIND: usize = 32;
+/// Cells along the axis (centred on the knee point).
+const ALONG: usize = 40;
 /// Least cosine between the skin's outward direction and the way to the plane for it to
 /// count (60°).
 const FACING: f32 = 0.5;
-/// Cells along the axis (centred on the knee point).
-const ALONG: usize = 40;
 
 /// How near to the contact plane each side's skin lies, over the plane behind the knee
 /// (see the module's documentation).
 #[derive(Debug, Clone)]
 pub(crate) struct SkinCover {
+    /// The plane's point on the knee axis (world)...
     point: Vec3,
+    /// ...its direction behind the knee, and along the axis: the cells' two directions.
     behind: Vec3,
     along: Vec3,
     /// Skin's least distance from the plane per cell, thigh side then calf side
@@ -111,59 +113,71 @@ mod tests {
     use super::*;
     use crate::body::KneeAxis;
 
-    /// A knee bent to `theta` (rad), its plane, its axis direction and the rotation that
-    /// carries the calf's rest positions to where they are now (thigh at rest).
-    fn bent(theta: f32) -> (KneeFold, Contact, Vec3, Quat) {
+    #[test]
+    fn the_floor_is_the_nearest_skin_facing_the_plane_per_cell_and_side() {
         let knee = KneeAxis {
             point: Vec3::new(0.01, -0.02, 0.45),
             axis: Vec3::new(-1.0, 0.05, 0.02).normalize(),
             condyle_radius: 0.025,
         };
+        let theta = 2.0;
         let fold = KneeFold::new(&knee, theta);
-        let contact = fold.contact(0.003);
-        let along = contact.normal.cross(contact.behind).normalize();
-        (
-            fold,
-            contact,
-            along,
-            Quat::from_axis_angle(fold.axis, theta),
-        )
-    }
-
-    #[test]
-    fn muscles_keep_under_skin_that_faces_the_plane_and_nowhere_else() {
-        let (fold, c, along, shank) = bent(2.0);
+        let shank = Quat::from_axis_angle(fold.axis, theta);
+        // The thigh turned and moved: the plane and the skin in the world.
+        let (tq, tt) = (
+            Quat::from_axis_angle(Vec3::new(0.3, 1.0, 0.2).normalize(), 0.4),
+            Vec3::new(0.1, -0.2, 0.3),
+        );
+        let rest_plane = fold.contact(0.003);
+        let c = Contact {
+            point: tq * rest_plane.point + tt,
+            normal: tq * rest_plane.normal,
+            behind: tq * rest_plane.behind,
+            ..rest_plane
+        };
+        let along = c.normal.cross(c.behind).normalize();
         let at = |b: f32, a: f32, h: f32| c.point + c.behind * b + along * a + c.normal * h;
-        // Thigh skin facing the plane 20 and 25 mm from it over one cell, 30 mm over the
-        // next; calf skin 15 mm from it (given at rest: the shank turns it there).
-        let to_rest = |p: Vec3| fold.point + shank.inverse() * (p - fold.point);
-        let skin = [
-            (at(0.105, 0.003, 0.025), -c.normal, true),
-            (at(0.108, 0.006, 0.020), -c.normal, true),
-            (at(0.115, 0.003, 0.030), -c.normal, true),
+        // Rest position and outward direction of skin that lies at `p`, facing `out`
+        // (world), on the thigh or the calf.
+        let thigh = |p: Vec3, out: Vec3| (tq.inverse() * (p - tt), tq.inverse() * out, true);
+        let calf = |p: Vec3, out: Vec3| {
+            let r = tq.inverse() * (p - tt) - fold.point;
             (
-                to_rest(at(0.105, 0.003, -0.015)),
-                shank.inverse() * c.normal,
+                fold.point + shank.inverse() * r,
+                shank.inverse() * (tq.inverse() * out),
                 false,
-            ),
-            // Skin turned away from the plane (the sides of the leg) holds nothing.
-            (at(0.155, 0.003, 0.010), c.behind, true),
+            )
+        };
+        // Toward the plane from the thigh, turned `deg` degrees about the axis.
+        let tilted = |deg: f32| Quat::from_axis_angle(along, deg.to_radians()) * -c.normal;
+        let skin = [
+            // Thigh skin 20 and 25 mm from the plane over one cell, 30 mm over the next.
+            thigh(at(0.105, 0.003, 0.025), -c.normal),
+            thigh(at(0.108, 0.006, 0.020), tilted(50.0)),
+            thigh(at(0.115, 0.003, 0.030), -c.normal),
+            // Calf skin 15 mm from it.
+            calf(at(0.105, 0.003, -0.015), c.normal),
+            // Skin turned 70° from the plane, or away from it, holds nothing.
+            thigh(at(0.155, 0.003, 0.010), tilted(70.0)),
+            thigh(at(0.165, 0.003, 0.010), c.normal),
         ];
-        let cover = SkinCover::new(&skin, &fold, &c, (Quat::IDENTITY, Vec3::ZERO), 0.004);
+        let cover = SkinCover::new(&skin, &fold, &c, (tq, tt), 0.004);
         let floor = |b: f32, a: f32, h: f32, thigh: bool| cover.floor(at(b, a, h), thigh);
-        // The nearest skin over the cell, and the depth under it, whatever the height.
-        assert!((floor(0.101, 0.001, 0.06, true) - 0.024).abs() < 1e-6);
-        assert!((floor(0.109, 0.009, 0.0, true) - 0.024).abs() < 1e-6);
-        assert!((floor(0.111, 0.001, 0.05, true) - 0.034).abs() < 1e-6);
-        assert!((floor(0.101, 0.001, -0.05, false) - 0.019).abs() < 1e-6);
-        // Nothing over cells without skin facing the plane, in front of the axis, or
-        // on the other side's skin only.
+        // The nearest facing skin over the cell, and the depth under it, whatever the
+        // height of the point asked about.
+        assert!((floor(0.101, 0.001, 0.06, true) - 0.024).abs() < 1e-5);
+        assert!((floor(0.109, 0.009, 0.0, true) - 0.024).abs() < 1e-5);
+        assert!((floor(0.111, 0.001, 0.05, true) - 0.034).abs() < 1e-5);
+        assert!((floor(0.101, 0.001, -0.05, false) - 0.019).abs() < 1e-5);
+        // Nothing over cells whose skin does not face the plane, without skin, in front
+        // of the axis, beyond the field, or with the other side's skin only.
         for (b, a, thigh) in [
             (0.155, 0.003, true),
+            (0.165, 0.003, true),
             (0.125, 0.003, true),
             (-0.005, 0.003, true),
-            (0.115, 0.003, false),
             (0.105, 0.25, true),
+            (0.115, 0.003, false),
         ] {
             assert_eq!(
                 floor(b, a, 0.02, thigh),
@@ -171,5 +185,7 @@ mod tests {
                 "{b} {a} {thigh}"
             );
         }
+        // A point that is not a number lies over no cell.
+        assert_eq!(cover.floor(Vec3::NAN, true), f32::NEG_INFINITY);
     }
 }
