@@ -324,7 +324,8 @@ impl BoneSlide {
             .vertices
             .par_iter()
             .zip(self.nearest.par_iter_mut())
-            .filter(|((v, ..), _)| free[*v as usize]) // the rest moves rigidly with its bone
+            // The rest moves rigidly with its bone (to within 0.1 mm).
+            .filter(|((v, ..), _)| free[*v as usize])
             .map(|(&(v, b, d0), nearest)| {
                 let mesh = &meshes[b as usize];
                 let (q, t) = pose(mesh.body);

@@ -75,7 +75,8 @@ impl Tissue {
         let x = &mut self.fat.x;
         for &v in &fixed.posterior {
             let v = v as usize;
-            // Vertices outside the relaxed region sit on the fold, which keeps its side.
+            // Vertices outside the relaxed region sit on the fold (to within 0.1 mm), which
+            // keeps its side.
             if !self.fat.free[v] {
                 continue;
             }

@@ -88,14 +88,15 @@ impl Guard {
             // The fold's volume can only lower the floor: it matters below this one.
             v <= 0.5 * full && v <= 0.5 * full.min(hex_volume(safe, h)).max(0.0)
         };
-        // Elements outside the relaxed region are rigid copies of the fold's (valid).
+        // Elements outside the relaxed region are rigid copies of the fold's (valid), to
+        // within 0.1 mm (`RIGID_TOLERANCE_M2`), far less than an element's thickness.
         self.bad_el = (0..fat.hexes.len())
             .into_par_iter()
             .filter(|&e| fat.active[e] && too_small(&fat.x, e, fat))
             .collect();
-        // Triangles outside the relaxed region are where the fold put them (the tests
-        // check the fold's skin for crossings), so only pairs with a live triangle can
-        // cross.
+        // Triangles outside the relaxed region are where the fold put them, to within
+        // 0.1 mm, less than the contact gap (the tests check the whole skin for
+        // crossings), so only pairs with a live triangle can cross.
         if surface {
             self.live.clear();
             self.live.extend(

@@ -42,8 +42,8 @@ impl TissueMetrics {
     }
 
     /// Measures the elements the last update relaxed ([`super::FatSolver::active`]); the
-    /// others moved rigidly with a bone, so they have no deformation, no area change and
-    /// their rest volume.
+    /// others moved rigidly with a bone (to within 0.1 mm, `RIGID_TOLERANCE_M2`), so they
+    /// count as having no deformation, no area change and their rest volume.
     pub fn measure_active(t: &Tissue) -> Self {
         Self::measure_where(t, Some(&t.fat.active))
     }

@@ -62,13 +62,11 @@ const LAYER_GAP: f32 = 0.001;
 /// guarded against crossing; farther out the tissue moves nearly rigidly with its bone.
 const GUARD_RADIUS: f32 = 0.25;
 
-/// Squared distance (m²) from the fold below which a fat vertex counts as moving
-/// rigidly with its bone: 0.1 mm, a hundredth of a fat element and invisible, where a
-/// relaxation would move it less than that. At 1 µm the damped carry-over of earlier
-/// corrections kept some 13 900 of the 16 512 elements relaxing through a flexion and
-/// back; at 0.1 mm, 9 300–12 500 while it moves (phantom, `myoslice run` of a 134°
-/// flexion), the same figures in the tissue tests, and the shape matching 5–15 %
-/// cheaper (the README's speed section).
+/// Squared distance (m²) from the fold below which a fat vertex's first guess counts as
+/// moving rigidly with its bone, and is not relaxed: 0.1 mm, about 2 % of the slice
+/// spacing and a tenth of the contact gap, invisible. At 1 µm the damped carry-over of
+/// earlier corrections kept most elements relaxing long after they had stopped moving
+/// (docs/speed-history.md, 2026-12-04 night).
 const RIGID_TOLERANCE_M2: f32 = 1e-8;
 
 /// Bone surfaces for tissue queries: body and mesh (rest frame) of each lattice bone.
