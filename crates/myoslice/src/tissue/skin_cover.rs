@@ -10,7 +10,9 @@
 //! comes where its bone alone carries it (the crease draws it no further from the plane
 //! than that, see [`super::crease`]). A muscle vertex the plane watches keeps that far
 //! from the plane over its cell, and the fat's layers more, by the same rounds of ring
-//! shifts as keep it off the plane itself ([`super::bone_keep_out`]).
+//! shifts as keep it off the plane itself ([`super::bone_keep_out`]). At the deepest
+//! angles (134°) the skin's rigid place lies past the plane and the cover asks nothing
+//! beyond the plane's own margin: there the muscles have no room (docs/tissue-history.md).
 
 use glam::{Quat, Vec3};
 
@@ -43,8 +45,8 @@ pub(crate) struct SkinCover {
 }
 
 impl SkinCover {
-    /// The height field of the skin vertices `skin` (rest position, thigh side or not)
-    /// carried rigidly by their bones at knee `fold` with the thigh at pose `thigh`;
+    /// The height field of the skin vertices `skin` (rest position, outward direction,
+    /// thigh side or not) carried rigidly by their bones at knee `fold` with the thigh at pose `thigh`;
     /// `contact` is the plane (world), `depth` (m) how far under the skin muscles keep.
     pub(crate) fn new(
         skin: &[(Vec3, Vec3, bool)],
