@@ -46,23 +46,56 @@ pub(super) fn skin_limits(
     gap: f32,
     out: &mut Vec<(f32, f32)>,
 ) {
-    let (fixed, rest, layers) = (&tissue.fixed, &tissue.fat.rest, tissue.layers);
-    let shank = Quat::from_axis_angle(fold.axis, fold.theta);
+    let rigid = Rigid::new(fold, (tq, tt));
     out.clear();
-    out.extend(fixed.posterior_skin.iter().map(|&v| {
-        let (r, thigh) = (rest[v as usize], fixed.thigh_side[v as usize]);
-        let rigid = if thigh {
+    out.extend(
+        tissue
+            .fixed
+            .posterior_skin_rest
+            .iter()
+            .map(|&(r, col, thigh)| {
+                let (_, d) = contact.locate(rigid.place(r, thigh), thigh);
+                let col = rigid.turn(col, thigh);
+                let w = (-contact.off_side(col.normalize_or_zero(), thigh)).max(0.0);
+                (d.max(gap), w)
+            }),
+    );
+}
+
+/// How the bones alone carry the tissue at a knee fold: the thigh at its pose, the shank
+/// turned about the knee point by the knee angle as well. Where the skin would be, and
+/// which way it would face, if nothing but its bone moved it.
+pub(super) struct Rigid {
+    point: Vec3,
+    shank: Quat,
+    thigh: (Quat, Vec3),
+}
+
+impl Rigid {
+    /// The bones' carry at `fold`, with the thigh at pose `thigh`.
+    pub(super) fn new(fold: &KneeFold, thigh: (Quat, Vec3)) -> Self {
+        Self {
+            point: fold.point,
+            shank: Quat::from_axis_angle(fold.axis, fold.theta),
+            thigh,
+        }
+    }
+
+    /// Where rest point `r` of the thigh's side (`thigh`) or the shank's goes (world).
+    pub(super) fn place(&self, r: Vec3, thigh: bool) -> Vec3 {
+        let (tq, tt) = self.thigh;
+        if thigh {
             tq * r + tt
         } else {
-            tq * (fold.point + shank * (r - fold.point)) + tt
-        };
-        let (_, d) = contact.locate(rigid, thigh);
-        // Skin vertices are the last of their radial column (`FatLattice::vertex_index`).
-        let col = r - rest[v as usize - layers];
-        let col = if thigh { tq * col } else { tq * (shank * col) };
-        let w = (-contact.off_side(col.normalize_or_zero(), thigh)).max(0.0);
-        (d.max(gap), w)
-    }));
+            tq * (self.point + self.shank * (r - self.point)) + tt
+        }
+    }
+
+    /// Where rest direction `v` of the thigh's side (`thigh`) or the shank's turns.
+    pub(super) fn turn(&self, v: Vec3, thigh: bool) -> Vec3 {
+        let tq = self.thigh.0;
+        if thigh { tq * v } else { tq * (self.shank * v) }
+    }
 }
 
 impl Tissue {

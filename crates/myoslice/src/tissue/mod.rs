@@ -85,8 +85,9 @@ struct TissueStatic {
     /// contact plane wherever it lies further from it than its bone alone would carry it
     /// (see [`crease`]), which happens mostly near the knee, where the fold moves it.
     posterior_skin: Vec<u32>,
-    /// Rest position, outward direction (its radial column's) and side (thigh or not)
-    /// of each of [`Self::posterior_skin`].
+    /// Rest position, radial column (from its inner vertex: it points outward) and side
+    /// (thigh or not) of each of [`Self::posterior_skin`].
+    /// Skin vertices are the last of their column (`FatLattice::vertex_index`).
     posterior_skin_rest: Vec<(Vec3, Vec3, bool)>,
     /// Body-surface triangles near the knee, checked for crossings after each update.
     guard_triangles: Vec<[u32; 3]>,
@@ -248,8 +249,7 @@ impl Tissue {
                 .iter()
                 .map(|&v| {
                     let p = fat.vertices[v as usize];
-                    let col = p - fat.vertices[v as usize - fat.layers];
-                    (p, col.normalize_or_zero(), p.z >= kz)
+                    (p, p - fat.vertices[v as usize - fat.layers], p.z >= kz)
                 })
                 .collect(),
             thigh_side: fat.vertices.iter().map(|p| p.z >= kz).collect(),

@@ -16,6 +16,7 @@
 
 use glam::{Quat, Vec3};
 
+use super::crease::Rigid;
 use super::knee_fold::{Contact, KneeFold};
 
 /// Cell size (m) of the height field.
@@ -45,9 +46,10 @@ pub(crate) struct SkinCover {
 }
 
 impl SkinCover {
-    /// The height field of the skin vertices `skin` (rest position, outward direction,
-    /// thigh side or not) carried rigidly by their bones at knee `fold` with the thigh at pose `thigh`;
-    /// `contact` is the plane (world), `depth` (m) how far under the skin muscles keep.
+    /// The height field of the skin vertices `skin` (rest position, outward direction of
+    /// any length, thigh side or not) carried rigidly by their bones ([`Rigid`]) at knee
+    /// `fold` with the thigh at pose `thigh`; `contact` is the plane (world), `depth` (m)
+    /// how far under the skin muscles keep.
     pub(crate) fn new(
         skin: &[(Vec3, Vec3, bool)],
         fold: &KneeFold,
@@ -55,7 +57,7 @@ impl SkinCover {
         (tq, tt): (Quat, Vec3),
         depth: f32,
     ) -> Self {
-        let shank = Quat::from_axis_angle(fold.axis, fold.theta);
+        let rigid = Rigid::new(fold, (tq, tt));
         let along = contact.normal.cross(contact.behind).normalize_or_zero();
         let mut cover = Self {
             point: contact.point,
@@ -65,19 +67,13 @@ impl SkinCover {
             depth,
         };
         for &(r, out, thigh) in skin {
-            let (p, out) = if thigh {
-                (tq * r + tt, tq * out)
-            } else {
-                (
-                    tq * (fold.point + shank * (r - fold.point)) + tt,
-                    tq * (shank * out),
-                )
-            };
             // Skin that does not face the plane (all of it while the knee is nearly
             // straight) lies over no muscle that the plane presses on.
+            let out = rigid.turn(out.normalize_or_zero(), thigh);
             if -contact.off_side(out, thigh) < FACING {
                 continue;
             }
+            let p = rigid.place(r, thigh);
             let (_, d) = contact.locate(p, thigh);
             if let Some(i) = cover.cell(p, thigh) {
                 let c = &mut cover.cells[i];
