@@ -52,6 +52,12 @@ class _MusclesOutsideSkin(TypedDict):
     vertices_over_1mm: npt.NDArray[np.int64]
     farthest_m: npt.NDArray[np.float32]
 
+class _BonesOutsideSkin(TypedDict):
+    """What :meth:`Simulation.bones_outside_skin` returns, one entry per bone."""
+
+    vertices_over_1mm: npt.NDArray[np.int64]
+    farthest_m: npt.NDArray[np.float32]
+
 @final
 class State:
     """An opaque checkpoint of a :class:`Simulation` (``Simulation.state()``)."""
@@ -251,6 +257,15 @@ class Simulation:
         (or where the skin cannot be closed into a mesh).
         Exact (the skin closed at both ends, a tree query per muscle vertex): tens of
         milliseconds, for checks rather than every frame."""
+
+    def bones_outside_skin(self) -> _BonesOutsideSkin:
+        """How far each bone's surface reaches out through the skin now, in
+        :attr:`bone_names` order, as :meth:`muscles_outside_skin` per bone; empty arrays
+        without tissue."""
+
+    @property
+    def bone_names(self) -> list[str]:
+        """Bone names, in the order of :meth:`bones_outside_skin`."""
 
     @property
     def n_fat_elements(self) -> int:

@@ -17,7 +17,10 @@ use numpy::{IntoPyArray, PyArray1, PyArray3, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use arrays::{SurfaceArrays, check_path, metric_array, per_muscle_reach, tri_array, vec3_array};
+use arrays::{
+    SurfaceArrays, breach_dict, check_path, excitation_pairs, metric_array, reach_dict, tri_array,
+    vec3_array,
+};
 use config::ConfigArgs;
 use errors::{Kind, OrPy, py_err};
 
@@ -235,34 +238,7 @@ impl PySimulation {
     /// Sets excitations from a dict {name: value} or an array in `muscle_names` order.
     fn set_excitations(&mut self, py: Python<'_>, values: &Bound<'_, PyAny>) -> PyResult<()> {
         if let Ok(d) = values.cast::<PyDict>() {
-            let mut pairs = Vec::with_capacity(d.len());
-            for (k, v) in d.iter() {
-                let name: String = k.extract().map_err(|_| {
-                    py_err(
-                        py,
-                        Kind::Invalid,
-                        "excitation keys must be muscle names (str)".into(),
-                    )
-                })?;
-                let value: f64 = v.extract().map_err(|_| {
-                    py_err(
-                        py,
-                        Kind::Invalid,
-                        format!("excitation of {name} must be a number"),
-                    )
-                })?;
-                self.sim.muscle_index(&name).or_py(py)?;
-                pairs.push((name, value));
-            }
-            for (name, value) in &pairs {
-                if !(value.is_finite() && (0.0..=1.0).contains(value)) {
-                    return Err(py_err(
-                        py,
-                        Kind::Invalid,
-                        format!("excitation of {name} = {value}: expected a value in [0, 1]"),
-                    ));
-                }
-            }
+            let pairs = excitation_pairs(py, d, &self.sim)?;
             for (name, value) in pairs {
                 self.sim.set_excitation(&name, value).or_py(py)?;
             }
@@ -473,7 +449,7 @@ impl PySimulation {
         let sim = &self.sim;
         let o = py.detach(|| sim.muscles_in_bone()).unwrap_or_default();
         let (count, deepest) = o.iter().map(|b| (b.vertices_over_1mm, b.deepest_m)).unzip();
-        per_muscle_reach(py, count, ("deepest_m", deepest))
+        reach_dict(py, count, ("deepest_m", deepest))
     }
 
     /// How far each muscle's surface reaches out through the skin now: a dict of
@@ -481,12 +457,25 @@ impl PySimulation {
     /// without tissue (or where the skin cannot be closed into a mesh).
     fn muscles_outside_skin<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let sim = &self.sim;
-        let o = py.detach(|| sim.muscles_outside_skin()).unwrap_or_default();
-        let (count, farthest) = o
+        breach_dict(py, py.detach(|| sim.muscles_outside_skin()))
+    }
+
+    /// How far each bone's surface reaches out through the skin now, as
+    /// `muscles_outside_skin` but per bone, in `bone_names` order.
+    fn bones_outside_skin<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let sim = &self.sim;
+        breach_dict(py, py.detach(|| sim.bones_outside_skin()))
+    }
+
+    /// Bone names, in the order of `bones_outside_skin`.
+    #[getter]
+    fn bone_names(&self) -> Vec<String> {
+        self.sim
+            .lattice()
+            .bones
             .iter()
-            .map(|b| (b.vertices_over_1mm, b.farthest_m))
-            .unzip();
-        per_muscle_reach(py, count, ("farthest_m", farthest))
+            .map(|b| b.name.clone())
+            .collect()
     }
 
     /// Number of fat elements (hexahedra).

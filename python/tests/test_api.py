@@ -267,6 +267,25 @@ def test_muscles_outside_skin_per_muscle(tissue: Simulation, rigid: Simulation) 
     assert empty["vertices_over_1mm"].shape == (0,) and empty["farthest_m"].shape == (0,)
 
 
+def test_bones_outside_skin_per_bone(tissue: Simulation, rigid: Simulation) -> None:
+    r = tissue.bones_outside_skin()
+    assert set(r) == {"vertices_over_1mm", "farthest_m"}
+    count, farthest = r["vertices_over_1mm"], r["farthest_m"]
+    n = len(tissue.bone_names)
+    assert n > 0 and "patella" in tissue.bone_names
+    assert count.shape == (n,) and count.dtype == np.int64
+    assert farthest.shape == (n,) and farthest.dtype == np.float32
+    assert ((farthest > 1e-3) == (count > 0)).all()
+    # The patella stays under the skin at rest and bent.
+    patella = tissue.bone_names.index("patella")
+    assert count[patella] == 0
+    flex(tissue, 0.3)
+    r = tissue.bones_outside_skin()
+    assert r["farthest_m"][patella] < 3e-3 and np.isfinite(r["farthest_m"]).all()
+    empty = rigid.bones_outside_skin()
+    assert empty["vertices_over_1mm"].shape == (0,) and empty["farthest_m"].shape == (0,)
+
+
 def test_set_excitation_single(rigid: Simulation) -> None:
     rigid.set_excitation("semimembranosus", 0.25)
     e = rigid.excitations

@@ -317,6 +317,15 @@ impl Simulation {
         self.tissue.as_ref().and_then(|t| t.muscles_outside_skin())
     }
 
+    /// How far each bone's surface reaches out through the skin now, in the lattice's bone
+    /// order (exact, as [`Simulation::muscles_outside_skin`]). None when tissue is disabled
+    /// (or its skin cannot be closed into a mesh).
+    pub fn bones_outside_skin(&self) -> Option<Vec<SkinBreach>> {
+        self.tissue
+            .as_ref()
+            .and_then(|t| t.bones_outside_skin(&self.frames))
+    }
+
     /// Wall-clock time spent in `step` since the build or `reset_timers`.
     pub fn timers(&self) -> &StepTimers {
         &self.timers

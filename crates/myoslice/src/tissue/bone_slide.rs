@@ -151,6 +151,11 @@ impl BoneMesh {
         }
     }
 
+    /// Outward unit normal of triangle `t` (zero for a collapsed one).
+    pub(crate) fn normal(&self, t: u32) -> Vec3 {
+        self.normals.get(t as usize).copied().unwrap_or(Vec3::ZERO)
+    }
+
     /// The body the bone moves with.
     pub(crate) fn body(&self) -> BodyId {
         self.body

@@ -7,6 +7,7 @@ mod bone_overlap;
 mod bone_slide;
 mod crease;
 mod distance_grid;
+mod fat_keep_out;
 mod fat_lanes;
 pub mod fat_solver;
 mod guard;
@@ -20,6 +21,8 @@ mod phases;
 pub mod polar;
 mod skin_breach;
 mod skin_cover;
+#[cfg(test)]
+mod test_shapes;
 mod tissue_backup;
 mod tissue_config;
 mod update_back;
@@ -50,6 +53,7 @@ use crate::muscle::{BodyFrames, MuscleUnit};
 use bone_keep_out::Bones;
 pub use bone_overlap::BoneOverlap;
 use bone_slide::{BoneMesh, BoneSlide};
+use fat_keep_out::FatKeepOut;
 use guard::Guard;
 
 /// Share of a muscle surface's sliding (along the fat layer) that drags the fat over it.
@@ -151,6 +155,8 @@ pub struct Tissue {
     fixed: Arc<TissueStatic>,
     /// Fat vertices that slide on bone, with the triangle each last touched.
     bone_slide: BoneSlide,
+    /// Fat vertices the fold can bring near a bone, kept out of it.
+    fat_keep_out: FatKeepOut,
     /// Motion of the last update beyond the skinned guess (for momentum).
     drift: Vec<Vec3>,
     scratch: Scratch,
@@ -243,6 +249,15 @@ impl Tissue {
             .copied()
             .filter(|&v| v as usize % (fat.layers + 1) == fat.layers)
             .collect();
+        let zone = FoldZone::new(&knee, &fat.vertices, &fat.hexes);
+        let fat_keep_out = FatKeepOut::new(
+            &knee,
+            &fat.vertices,
+            &zone,
+            |v| v % (fat.layers + 1),
+            &bone_meshes,
+            &bones,
+        );
         let fixed = TissueStatic {
             muscle_ref,
             posterior_skin_rest: posterior_skin
@@ -256,7 +271,7 @@ impl Tissue {
             posterior_skin,
             posterior,
             guard_triangles,
-            zone: FoldZone::new(&knee, &fat.vertices, &fat.hexes),
+            zone,
             bone_meshes,
             bones: Arc::clone(&bones),
             outer_faces,
@@ -269,6 +284,7 @@ impl Tissue {
             drift: vec![Vec3::ZERO; nv],
             fat: solver,
             bone_slide: BoneSlide::new(&on_bone, &fat.vertices, &bones),
+            fat_keep_out,
             fixed: Arc::new(fixed),
             scratch: Scratch::default(),
             knee,
@@ -333,6 +349,26 @@ impl Tissue {
     pub fn muscles_outside_skin(&self) -> Option<Vec<SkinBreach>> {
         let muscles: Vec<&[Vec3]> = self.muscles.iter().map(|m| m.current.as_slice()).collect();
         self.fixed.skin.breaches(&self.fat.x, &muscles)
+    }
+
+    /// How far each bone's surface reaches out through the skin with the bodies at
+    /// `frames`, in the lattice's bone order (exact, as
+    /// [`Tissue::muscles_outside_skin`]; for checks, not for every update). None when the
+    /// skin is degenerate.
+    pub fn bones_outside_skin(&self, frames: &BodyFrames) -> Option<Vec<SkinBreach>> {
+        let bones: Vec<Vec<Vec3>> = self
+            .fixed
+            .bones
+            .iter()
+            .map(|(body, m)| {
+                m.vertices()
+                    .iter()
+                    .map(|&p| frames.point(*body, p))
+                    .collect()
+            })
+            .collect();
+        let bones: Vec<&[Vec3]> = bones.iter().map(Vec::as_slice).collect();
+        self.fixed.skin.breaches(&self.fat.x, &bones)
     }
 
     /// Outer (skin) face of each outer-layer element, with its rest area (m²).
@@ -519,6 +555,9 @@ impl Tissue {
             &fixed.bones,
             pose,
         );
+        // The skin in front of the knee lifts over bone the fold brings under it.
+        self.fat_keep_out
+            .apply(&mut self.fat.x, &fixed.bone_meshes, &fixed.bones, pose);
         self.apply_contact(&contact, gap, &sc.skin_limits);
         self.theta = theta;
         self.scratch = sc;

@@ -18,6 +18,7 @@ pub(crate) struct TissueBackup {
     theta: f32,
     metrics: LazyMetrics,
     bone_slide: BoneSlide,
+    fat_keep_out: Vec<u32>,
     muscles: Vec<(Vec<Vec3>, f64, KeepOutMemory)>,
 }
 
@@ -35,6 +36,7 @@ impl Tissue {
             theta: self.theta,
             metrics: self.metrics.clone(),
             bone_slide: self.bone_slide.clone(),
+            fat_keep_out: self.fat_keep_out.memory(),
             muscles: self
                 .muscles
                 .iter()
@@ -49,6 +51,7 @@ impl Tissue {
         (self.fat.free, self.fat.active) = (b.fat_free, b.fat_active);
         (self.drift, self.theta, self.metrics) = (b.drift, b.theta, b.metrics);
         self.bone_slide = b.bone_slide;
+        self.fat_keep_out.recall(b.fat_keep_out);
         // Shapes placed ahead for an update that will not come now.
         self.placed = None;
         for (shape, (c, v, keep)) in self.muscles.iter_mut().zip(b.muscles) {
