@@ -28,8 +28,17 @@ const WATCH_M: f32 = 0.02;
 const SWEEP_STEP_DEG: usize = 5;
 const SWEEP_TOP_DEG: usize = 160;
 
-/// The (fat vertex, bone) pairs to watch, grouped by vertex, with the triangle each pair
-/// was last nearest.
+/// What a pair last learnt: where its walk starts, and a place (bone frame) its vertex was
+/// known to lie at least so far outside the bone (m; 0 when not known).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct PairMemory {
+    triangle: u32,
+    at: Vec3,
+    clear_by: f32,
+}
+
+/// The (fat vertex, bone) pairs to watch, grouped by vertex, with what each pair last
+/// learnt.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct FatKeepOut {
     /// Watched vertices, ascending, with their clearance (m).
@@ -37,8 +46,8 @@ pub(crate) struct FatKeepOut {
     /// Pairs of `vertices[i]`: `bones[start[i]..start[i + 1]]`, bone index ascending.
     start: Vec<u32>,
     bones: Vec<u32>,
-    /// Triangle each pair was last nearest (parallel to `bones`).
-    nearest: Vec<u32>,
+    /// What each pair last learnt (parallel to `bones`).
+    memory: Vec<PairMemory>,
 }
 
 impl FatKeepOut {
@@ -107,22 +116,25 @@ impl FatKeepOut {
             for b in near {
                 let (mesh, tree) = (&meshes[b as usize], &surfaces[b as usize].1);
                 out.bones.push(b);
-                out.nearest
-                    .push(mesh.walk_from_tree(tree, rest[v as usize]).triangle);
+                out.memory.push(PairMemory {
+                    triangle: mesh.walk_from_tree(tree, rest[v as usize]).triangle,
+                    at: Vec3::ZERO,
+                    clear_by: 0.0,
+                });
             }
             out.start.push(out.bones.len() as u32);
         }
         out
     }
 
-    /// Where each pair's walk starts: the state an update changes.
-    pub(crate) fn memory(&self) -> Vec<u32> {
-        self.nearest.clone()
+    /// What each pair last learnt: the state an update changes.
+    pub(crate) fn memory(&self) -> Vec<PairMemory> {
+        self.memory.clone()
     }
 
     /// Puts back what [`Self::memory`] took.
-    pub(crate) fn recall(&mut self, nearest: Vec<u32>) {
-        self.nearest = nearest;
+    pub(crate) fn recall(&mut self, memory: Vec<PairMemory>) {
+        self.memory = memory;
     }
 
     /// Moves each watched vertex of `x` that lies inside a bone, or nearer it than its
@@ -138,10 +150,10 @@ impl FatKeepOut {
     ) {
         let xs = &*x;
         let (start, bones) = (&self.start, &self.bones);
-        // Each vertex's pairs are a contiguous run of `nearest`: split it per vertex, so
+        // Each vertex's pairs are a contiguous run of `memory`: split it per vertex, so
         // vertices go in parallel and each is written back once, in order.
-        let mut runs: Vec<&mut [u32]> = Vec::with_capacity(self.vertices.len());
-        let mut rest = self.nearest.as_mut_slice();
+        let mut runs: Vec<&mut [PairMemory]> = Vec::with_capacity(self.vertices.len());
+        let mut rest = self.memory.as_mut_slice();
         for w in start.windows(2) {
             let (run, tail) = rest.split_at_mut((w[1] - w[0]) as usize);
             runs.push(run);
@@ -152,7 +164,7 @@ impl FatKeepOut {
             .par_iter()
             .zip(runs.into_par_iter())
             .enumerate()
-            .map(|(i, (&(v, clear), nearest))| {
+            .map(|(i, (&(v, clear), memory))| {
                 let mut p = xs[v as usize];
                 let mut moved = false;
                 for (k, b) in bones[start[i] as usize..start[i + 1] as usize]
@@ -162,14 +174,22 @@ impl FatKeepOut {
                     let (mesh, tree) = (&meshes[*b as usize], &surfaces[*b as usize].1);
                     let (q, t) = pose(mesh.body());
                     let local = q.inverse() * (p - t);
-                    // Most watched vertices are well clear: the distance grid says so.
-                    if mesh.clear_bound(local, tree) > clear {
+                    let m = &mut memory[k];
+                    // Most watched vertices are well clear: still within the ball they were
+                    // last known clear by, or vouched for by the distance grid.
+                    if m.clear_by - local.distance(m.at) > clear {
                         continue;
                     }
-                    let w = mesh.walk_checked(nearest[k], local, tree);
-                    nearest[k] = w.triangle;
+                    let bound = mesh.clear_bound(local, tree);
+                    if bound > clear {
+                        (m.at, m.clear_by) = (local, bound);
+                        continue;
+                    }
+                    let w = mesh.walk_checked(m.triangle, local, tree);
                     let d = w.point.distance(local);
+                    (m.triangle, m.at, m.clear_by) = (w.triangle, local, 0.0);
                     if !w.inside && d >= clear {
+                        m.clear_by = d;
                         continue;
                     }
                     let out = if w.inside {
@@ -290,7 +310,14 @@ mod tests {
             vertices: vec![(0, 0.003), (1, 0.003), (2, 0.003)],
             start: vec![0, 1, 2, 3],
             bones: vec![0; 3],
-            nearest: vec![0; 3],
+            memory: vec![
+                PairMemory {
+                    triangle: 0,
+                    at: Vec3::ZERO,
+                    clear_by: 0.0,
+                };
+                3
+            ],
         };
         // Inside near the top face, just above it, and well clear of it.
         let mut x = vec![

@@ -5,6 +5,7 @@ use glam::{Quat, Vec3};
 use super::Tissue;
 use super::bone_keep_out::KeepOutMemory;
 use super::bone_slide::BoneSlide;
+use super::fat_keep_out::PairMemory;
 use super::metrics::LazyMetrics;
 
 /// A tissue's changing state, to put back after a failed update or `step` call.
@@ -18,7 +19,7 @@ pub(crate) struct TissueBackup {
     theta: f32,
     metrics: LazyMetrics,
     bone_slide: BoneSlide,
-    fat_keep_out: Vec<u32>,
+    fat_keep_out: Vec<PairMemory>,
     muscles: Vec<(Vec<Vec3>, f64, KeepOutMemory)>,
 }
 
