@@ -46,14 +46,9 @@ class _MusclesInBone(TypedDict):
     vertices_over_1mm: npt.NDArray[np.int64]
     deepest_m: npt.NDArray[np.float32]
 
-class _MusclesOutsideSkin(TypedDict):
-    """What :meth:`Simulation.muscles_outside_skin` returns, one entry per muscle."""
-
-    vertices_over_1mm: npt.NDArray[np.int64]
-    farthest_m: npt.NDArray[np.float32]
-
-class _BonesOutsideSkin(TypedDict):
-    """What :meth:`Simulation.bones_outside_skin` returns, one entry per bone."""
+class _OutsideSkin(TypedDict):
+    """What :meth:`Simulation.muscles_outside_skin` and
+    :meth:`Simulation.bones_outside_skin` return, one entry per muscle or bone."""
 
     vertices_over_1mm: npt.NDArray[np.int64]
     farthest_m: npt.NDArray[np.float32]
@@ -250,7 +245,7 @@ class Simulation:
         ``deepest_m`` (float32, m); empty arrays without tissue. Exact (a tree query per
         vertex near a bone): tens of milliseconds, for checks rather than every frame."""
 
-    def muscles_outside_skin(self) -> _MusclesOutsideSkin:
+    def muscles_outside_skin(self) -> _OutsideSkin:
         """How far each muscle's surface reaches out through the skin now, in
         :attr:`muscle_names` order: ``vertices_over_1mm`` (int64, vertices more than 1 mm
         outside the skin) and ``farthest_m`` (float32, m); empty arrays without tissue
@@ -258,7 +253,7 @@ class Simulation:
         Exact (the skin closed at both ends, a tree query per muscle vertex): tens of
         milliseconds, for checks rather than every frame."""
 
-    def bones_outside_skin(self) -> _BonesOutsideSkin:
+    def bones_outside_skin(self) -> _OutsideSkin:
         """How far each bone's surface reaches out through the skin now, in
         :attr:`bone_names` order, as :meth:`muscles_outside_skin` per bone; empty arrays
         without tissue."""

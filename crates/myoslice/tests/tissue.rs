@@ -87,43 +87,6 @@ fn stretched_skin_shows_positive_area_change_and_compressed_skin_negative() {
     assert!(outer(80, 0).abs() < 1e-5, "untouched skin keeps its area");
 }
 
-/// Drives a flexion to deep flexion with the hamstrings, then back with the quadriceps,
-/// and calls `check` on every tissue update.
-fn flex_and_back(sim: &mut Simulation, speed: f64, mut check: impl FnMut(&Simulation)) -> f64 {
-    let flex = [
-        "semitendinosus",
-        "semimembranosus",
-        "biceps_femoris_long",
-        "biceps_femoris_short",
-        "gracilis",
-        "sartorius",
-    ];
-    let ext = [
-        "rectus_femoris",
-        "vastus_lateralis",
-        "vastus_medialis",
-        "vastus_intermedius",
-    ];
-    let mut max_angle = 0.0f64;
-    let period = sim.tissue().unwrap().period();
-    let steps = (1.6 / speed / period).ceil() as usize;
-    for k in 0..steps {
-        let t = k as f64 * period * speed;
-        for m in flex {
-            sim.set_excitation(m, if t < 0.8 { 1.0 } else { 0.0 })
-                .unwrap();
-        }
-        for m in ext {
-            sim.set_excitation(m, if t < 0.8 { 0.0 } else { (0.6 * speed).min(1.0) })
-                .unwrap();
-        }
-        sim.step(period).unwrap();
-        max_angle = max_angle.max(sim.knee_angle());
-        check(sim);
-    }
-    max_angle
-}
-
 fn muscle_volumes_stay_within_one_percent(lattice: Lattice) {
     let mut sim = Simulation::new(
         lattice,
@@ -133,7 +96,7 @@ fn muscle_volumes_stay_within_one_percent(lattice: Lattice) {
     .unwrap();
     let names: Vec<String> = sim.muscles().iter().map(|m| m.name.clone()).collect();
     let mut range = vec![(1.0f32, 1.0f32); names.len()];
-    let max = flex_and_back(&mut sim, 1.0, |s| {
+    let max = common::flex_and_back(&mut sim, 1.0, |s| {
         let ratios = &s.tissue_metrics().unwrap().muscle_volume_ratio;
         for (r, v) in range.iter_mut().zip(ratios) {
             *r = (r.0.min(*v), r.1.max(*v));
@@ -192,7 +155,7 @@ fn tissue_never_breaks(lattice: Lattice, speed: f64) {
     .unwrap();
     let tri = sim.lattice().fat.surface_triangles();
     let (mut inverted, mut crossings, mut finite) = (0usize, 0usize, true);
-    let max = flex_and_back(&mut sim, speed, |s| {
+    let max = common::flex_and_back(&mut sim, speed, |s| {
         let t = s.tissue().unwrap();
         inverted = inverted.max(s.tissue_metrics().unwrap().inverted);
         finite &= t.fat_vertices().iter().all(|p| p.is_finite());
@@ -237,19 +200,6 @@ fn visible_human_fat_never_inverts_nor_self_intersects_at_three_times_the_speed(
     tissue_never_breaks(lattice.clone(), 3.0);
 }
 
-/// The Visible Human leg's simulation with the default options (None without the data).
-fn visible_human() -> Option<Simulation> {
-    let lattice = common::vh_lattice()?;
-    Some(
-        Simulation::new(
-            lattice.clone(),
-            SimulationConfig::default(),
-            &MuscleCatalogue::default(),
-        )
-        .unwrap(),
-    )
-}
-
 /// Flexes `sim` to about 130° and back; returns how many muscle vertices lay more than
 /// 1 mm inside bone at rest, how many more at the worst update, and the deepest of any
 /// muscle deeper than at rest (m).
@@ -257,7 +207,7 @@ fn muscles_in_bone_through_a_deep_flexion(mut sim: Simulation) -> (usize, usize,
     let rest = sim.muscles_in_bone().unwrap();
     let at_rest: usize = rest.iter().map(|o| o.vertices_over_1mm).sum();
     let (mut added, mut deepest) = (0usize, 0.0f32);
-    flex_and_back(&mut sim, 1.0, |s| {
+    common::flex_and_back(&mut sim, 1.0, |s| {
         let now = s.muscles_in_bone().unwrap();
         let count: usize = now.iter().map(|o| o.vertices_over_1mm).sum();
         added = added.max(count.saturating_sub(at_rest));
@@ -293,7 +243,7 @@ fn muscles_are_kept_out_of_bone_through_a_deep_flexion() {
 
 #[test]
 fn visible_human_muscles_are_kept_out_of_bone_through_a_deep_flexion() {
-    let Some(sim) = visible_human() else {
+    let Some(sim) = common::visible_human() else {
         return;
     };
     let (at_rest, added, deepest) = muscles_in_bone_through_a_deep_flexion(sim);
@@ -309,7 +259,7 @@ fn visible_human_muscles_are_kept_out_of_bone_through_a_deep_flexion() {
 fn every_tissue_vertex_stays_finite_at_three_times_the_speed() {
     let mut sim = Simulation::phantom(SimulationConfig::default()).unwrap();
     let mut finite = true;
-    flex_and_back(&mut sim, 3.0, |s| {
+    common::flex_and_back(&mut sim, 3.0, |s| {
         let t = s.tissue().unwrap();
         finite &= t.fat_vertices().iter().all(|p| p.is_finite());
         finite &= t
@@ -543,7 +493,7 @@ fn muscles_stepping_beside_the_guard_give_the_same_bits_as_one_after_the_other()
 fn muscles_reach_out_no_further_than_recorded(mut sim: Simulation) {
     let (mut most, mut below_70, mut farthest, mut rising_45) = (0usize, 0usize, 0.0f32, 0.0f32);
     let mut top = 0.0f64;
-    flex_and_back(&mut sim, 1.0, |s| {
+    common::flex_and_back(&mut sim, 1.0, |s| {
         let out = s.muscles_outside_skin().unwrap();
         let count: usize = out.iter().map(|b| b.vertices_over_1mm).sum();
         let far = out.iter().map(|b| b.farthest_m).fold(0.0, f32::max);
@@ -584,65 +534,7 @@ fn muscles_reach_out_through_the_skin_no_further_than_recorded_in_a_deep_flexion
 
 #[test]
 fn visible_human_muscles_reach_out_through_the_skin_no_further_than_recorded() {
-    if let Some(sim) = visible_human() {
+    if let Some(sim) = common::visible_human() {
         muscles_reach_out_no_further_than_recorded(sim);
-    }
-}
-
-/// Bones reach out through the skin over the deep flexion no further than recorded. The
-/// patella, carried by the shank under skin the fold turns by less, came out from about
-/// 70° (108 vertices on the phantom, 6.9 mm; 111 on the Visible Human, 7.6 mm) until the
-/// fat the fold can bring near a bone was kept off it (`tissue/fat_keep_out.rs`): now
-/// 7 and 5 vertices, 2.2 and 1.7 mm, where the skin's flat triangles span the bone's
-/// edges. Behind the knee the fibula's head reaches the contact plane from about 95° and
-/// comes out between the two skins where they meet on it: 314 and 247 vertices, 8.9 and
-/// 7.1 mm. No other bone comes out beyond what stands out at rest (the sacrum, past the
-/// lattice's top end).
-fn bones_reach_out_no_further_than_recorded(mut sim: Simulation) {
-    let names: Vec<String> = sim.lattice().bones.iter().map(|b| b.name.clone()).collect();
-    let rest = sim.bones_outside_skin().unwrap();
-    // Per bone: most vertices out beyond those at rest, and the farthest then (m).
-    let mut worst = vec![(0usize, 0.0f32); names.len()];
-    flex_and_back(&mut sim, 1.0, |s| {
-        let now = s.bones_outside_skin().unwrap();
-        for ((w, n), r) in worst.iter_mut().zip(&now).zip(&rest) {
-            if n.vertices_over_1mm > r.vertices_over_1mm {
-                w.0 = w.0.max(n.vertices_over_1mm - r.vertices_over_1mm);
-                w.1 = w.1.max(n.farthest_m);
-            }
-        }
-    });
-    let summary: Vec<String> = names
-        .iter()
-        .zip(&worst)
-        .filter(|(_, w)| w.0 > 0)
-        .map(|(n, w)| format!("{n}: {} vertices, {:.1} mm", w.0, w.1 * 1e3))
-        .collect();
-    eprintln!("bone vertices > 1 mm outside the skin beyond rest, at most: {summary:?}");
-    for (name, &(count, far)) in names.iter().zip(&worst) {
-        let (most, farthest) = match name.as_str() {
-            "patella" => (15, 0.003),
-            "fibula" => (400, 0.010),
-            _ => (0, 0.0),
-        };
-        assert!(
-            count <= most && far <= farthest,
-            "{name}: {count} vertices > 1 mm outside the skin, {:.1} mm: {summary:?}",
-            far * 1e3
-        );
-    }
-}
-
-#[test]
-fn bones_reach_out_through_the_skin_no_further_than_recorded_in_a_deep_flexion() {
-    bones_reach_out_no_further_than_recorded(
-        Simulation::phantom(SimulationConfig::default()).unwrap(),
-    );
-}
-
-#[test]
-fn visible_human_bones_reach_out_through_the_skin_no_further_than_recorded() {
-    if let Some(sim) = visible_human() {
-        bones_reach_out_no_further_than_recorded(sim);
     }
 }

@@ -10,6 +10,7 @@
 //! (watching it there too brought more muscle out through the skin at deep flexion).
 
 use glam::{Quat, Vec3};
+use parry3d::query::{Ray, RayCast};
 use parry3d::shape::TriMesh;
 use rayon::prelude::*;
 
@@ -17,16 +18,19 @@ use super::bone_slide::BoneMesh;
 use super::knee_fold::{FoldZone, KneeFold};
 use crate::body::{BodyId, KneeAxis};
 
-/// Clearance (m) kept from bone per layer above the inner one: the skin of a two-layer
-/// lattice keeps 3 mm off bone, its inner vertices only outside it.
+/// Clearance (m) kept from bone per layer above the inner one (the inner layer is not
+/// watched): the skin of a two-layer lattice keeps 3 mm off bone.
 const CLEARANCE_PER_LAYER: f32 = 0.0015;
 /// A pair is watched when, at some knee angle of the sweep, its vertex comes within its
 /// clearance and this much more of the bone (m).
 const WATCH_M: f32 = 0.02;
-/// Knee angles (degrees) the build sweeps to find the pairs to watch: every 5° up to the
-/// deepest flexion the fold is built for.
+/// Knee angles (degrees) the build sweeps to find the pairs to watch: every 5°, from past
+/// any extension to past any flexion a knee's limits allow.
 const SWEEP_STEP_DEG: usize = 5;
-const SWEEP_TOP_DEG: usize = 160;
+const SWEEP_FROM_DEG: i32 = -30;
+const SWEEP_TO_DEG: i32 = 180;
+/// Farthest (m) a vertex inside a bone looks for its way out.
+const MAX_EXIT_M: f32 = 0.2;
 
 /// What a pair last learnt: where its walk starts, and a place (bone frame) its vertex was
 /// known to lie at least so far outside the bone (m; 0 when not known).
@@ -48,6 +52,9 @@ pub(crate) struct FatKeepOut {
     bones: Vec<u32>,
     /// What each pair last learnt (parallel to `bones`).
     memory: Vec<PairMemory>,
+    /// The knee axis (a point on it and its direction), the same in both bodies' rest
+    /// frames: in front of the knee the skin lies further from it than the bone under it.
+    axis: (Vec3, Vec3),
 }
 
 impl FatKeepOut {
@@ -62,18 +69,13 @@ impl FatKeepOut {
         meshes: &[BoneMesh],
         surfaces: &[(BodyId, TriMesh)],
     ) -> Self {
-        let folds: Vec<KneeFold> = (0..=SWEEP_TOP_DEG)
+        let folds: Vec<KneeFold> = (SWEEP_FROM_DEG..=SWEEP_TO_DEG)
             .step_by(SWEEP_STEP_DEG)
             .map(|d| KneeFold::new(knee, (d as f32).to_radians()))
             .collect();
         let boxes: Vec<(Vec3, Vec3)> = surfaces
             .iter()
-            .map(|(_, m)| {
-                m.vertices().iter().fold(
-                    (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-                    |(lo, hi), v| (lo.min(*v), hi.max(*v)),
-                )
-            })
+            .map(|(_, m)| (m.local_aabb().mins, m.local_aabb().maxs))
             .collect();
         let watched: Vec<(u32, f32, Vec<u32>)> = (0..rest.len())
             .into_par_iter()
@@ -109,7 +111,10 @@ impl FatKeepOut {
                 (!near.is_empty()).then_some((v as u32, clear, near))
             })
             .collect();
-        let mut out = Self::default();
+        let mut out = Self {
+            axis: (knee.point, knee.axis.normalize_or(Vec3::X)),
+            ..Self::default()
+        };
         out.start.push(0);
         for (v, clear, near) in watched {
             out.vertices.push((v, clear));
@@ -137,19 +142,23 @@ impl FatKeepOut {
         self.memory = memory;
     }
 
-    /// Moves each watched vertex of `x` that lies inside a bone, or nearer it than its
-    /// clearance, out along the bone's normal to its clearance; `pose` gives the bodies'
-    /// poses (rotation, translation). A vertex watched against two bones is kept from each
-    /// in turn, in bone order.
+    /// Moves each free watched vertex of `x` (`free`: those the update relaxes, whose
+    /// elements the guard checks) that lies nearer a bone than its clearance away from
+    /// the bone's nearest point to its clearance, and one inside a bone out away from the
+    /// knee axis (the nearest way out of a vertex deep in the patella can lead behind it),
+    /// to its clearance past where it leaves the bone; `pose` gives the bodies' poses
+    /// (rotation, translation). A vertex watched against two bones is kept from each in
+    /// turn, in bone order.
     pub(crate) fn apply(
         &mut self,
         x: &mut [Vec3],
+        free: &[bool],
         meshes: &[BoneMesh],
         surfaces: &[(BodyId, TriMesh)],
         pose: impl Fn(BodyId) -> (Quat, Vec3) + Sync,
     ) {
         let xs = &*x;
-        let (start, bones) = (&self.start, &self.bones);
+        let (start, bones, (axis_at, axis)) = (&self.start, &self.bones, self.axis);
         // Each vertex's pairs are a contiguous run of `memory`: split it per vertex, so
         // vertices go in parallel and each is written back once, in order.
         let mut runs: Vec<&mut [PairMemory]> = Vec::with_capacity(self.vertices.len());
@@ -165,6 +174,9 @@ impl FatKeepOut {
             .zip(runs.into_par_iter())
             .enumerate()
             .map(|(i, (&(v, clear), memory))| {
+                if !free[v as usize] {
+                    return None;
+                }
                 let mut p = xs[v as usize];
                 let mut moved = false;
                 for (k, b) in bones[start[i] as usize..start[i + 1] as usize]
@@ -187,20 +199,42 @@ impl FatKeepOut {
                     }
                     let w = mesh.walk_checked(m.triangle, local, tree);
                     let d = w.point.distance(local);
+                    // A settled walk's nearest point may be only local, so it cannot vouch
+                    // for a ball of its own: the ball known before shrinks by how far the
+                    // vertex has gone.
+                    let shrunk = (m.clear_by - local.distance(m.at)).max(0.0);
                     (m.triangle, m.at, m.clear_by) = (w.triangle, local, 0.0);
                     if !w.inside && d >= clear {
-                        m.clear_by = d;
+                        m.clear_by = shrunk;
                         continue;
                     }
-                    let out = if w.inside {
-                        w.point - local
-                    } else {
-                        local - w.point
-                    };
-                    let out = out
-                        .try_normalize()
-                        .unwrap_or_else(|| mesh.normal(w.triangle));
-                    p = q * (w.point + out * clear) + t;
+                    let radial = local - axis_at;
+                    let away = (radial - axis * radial.dot(axis)).try_normalize();
+                    let exit = away.filter(|_| w.inside).and_then(|dir| {
+                        let toi = tree.cast_local_ray(&Ray::new(local, dir), MAX_EXIT_M, false)?;
+                        let exit = local + dir * (toi + clear);
+                        // Left through a face aslant the way out: its clearance from the
+                        // nearest point, not along the way.
+                        let near = mesh.walk(w.triangle, exit);
+                        let d = near.point.distance(exit);
+                        Some(if d < clear && !near.inside {
+                            near.point + (exit - near.point) * (clear / d.max(f32::MIN_POSITIVE))
+                        } else {
+                            exit
+                        })
+                    });
+                    let to = exit.unwrap_or_else(|| {
+                        let out = if w.inside {
+                            w.point - local
+                        } else {
+                            local - w.point
+                        };
+                        let out = out
+                            .try_normalize()
+                            .unwrap_or_else(|| mesh.normal(w.triangle));
+                        w.point + out * clear
+                    });
+                    p = q * to + t;
                     moved = true;
                 }
                 moved.then_some((v, p))
@@ -229,9 +263,10 @@ mod tests {
     }
 
     #[test]
-    fn skin_the_fold_carries_into_a_shank_bone_is_lifted_to_its_clearance_and_only_it() {
+    fn skin_the_fold_carries_through_a_shank_bone_keeps_its_clearance_outside_it() {
         // Knee axis x through the origin: up is +z, front is −y. A patella-like box on
-        // the shank in front of the knee, above the joint line (ψ about 42–63° from up).
+        // the shank in front of the knee, above the joint line (ψ about 42–63° from up,
+        // 54–78 mm from the axis).
         let knee = KneeAxis {
             point: Vec3::ZERO,
             axis: Vec3::X,
@@ -243,14 +278,15 @@ mod tests {
             let psi = psi.to_radians();
             Vec3::new(0.0, -r * psi.sin(), r * psi.cos())
         };
-        // Skin (layer 2) on an arc below the box, where the fold turns it by less than the
-        // shank, so the box sweeps through it; an inner vertex (layer 0) on the same arc;
-        // skin behind the knee; skin far in front of the box, never near it.
-        let mut rest: Vec<Vec3> = (0..12).map(|k| at(95.0 + 5.0 * k as f32, 0.052)).collect();
+        // Skin (layer 2) on an arc 60 mm from the axis below the box, where the fold turns
+        // it by less than the shank, so the box sweeps through it (at rest 3.5 cm away,
+        // too far to watch by its rest place alone); an inner vertex (layer 0) on the same
+        // arc; skin behind the knee; skin far in front of the box, never near it.
+        let mut rest: Vec<Vec3> = (0..12).map(|k| at(95.0 + 5.0 * k as f32, 0.06)).collect();
         let inner = rest.len();
-        rest.push(at(100.0, 0.052));
+        rest.push(at(100.0, 0.06));
         let behind = rest.len();
-        rest.push(at(250.0, 0.052));
+        rest.push(at(250.0, 0.06));
         let far = rest.len();
         rest.push(at(70.0, 0.20));
         let layer_of = |v: usize| if v == inner { 0 } else { 2 };
@@ -269,14 +305,15 @@ mod tests {
                 .all(|v| !watched.contains(&(*v as u32)))
         );
         let clear = 2.0 * CLEARANCE_PER_LAYER;
-        let mut lifted = 0;
+        let free = vec![true; rest.len()];
+        let (mut inside, mut lifted) = (0, 0);
         for deg in (1..=30).map(|k| 5.0 * k as f32) {
             let theta = deg.to_radians();
             let fold = KneeFold::new(&knee, theta);
             let turn = Quat::from_axis_angle(Vec3::X, theta);
             let mut x: Vec<Vec3> = rest.iter().map(|&p| fold.map(p)).collect();
             let before = x.clone();
-            keep.apply(&mut x, &meshes, &surfaces, |b| match b {
+            keep.apply(&mut x, &free, &meshes, &surfaces, |b| match b {
                 BodyId::Thigh => (Quat::IDENTITY, Vec3::ZERO),
                 BodyId::Shank => (turn, Vec3::ZERO),
             });
@@ -288,48 +325,87 @@ mod tests {
                         "{deg}°: skin vertex {v} {d} m from the bone"
                     );
                 }
-                if watched.contains(&(v as u32)) {
-                    if p != b {
-                        lifted += 1;
-                        // Moved no further than to its clearance.
-                        assert!(d < clear + 1e-5, "{deg}°: vertex {v} lifted to {d} m");
-                    }
-                } else {
+                if !watched.contains(&(v as u32)) {
                     assert_eq!(p, b, "{deg}°: unwatched vertex {v} moved");
+                } else if p != b {
+                    lifted += 1;
+                    // Moved no further than to its clearance; out of the bone away from
+                    // the axis, past the bone's far side from it.
+                    assert!(d < clear + 1e-5, "{deg}°: vertex {v} lifted to {d} m");
+                    if box_distance(turn.inverse() * *b, lo, hi) < 0.0 {
+                        inside += 1;
+                        let r = |p: Vec3| p.y.hypot(p.z);
+                        assert!(r(*p) > r(*b), "{deg}°: vertex {v} pushed toward the axis");
+                    }
                 }
             }
         }
-        assert!(lifted >= 3, "only {lifted} vertices lifted off the bone");
+        assert!(
+            lifted >= 3 && inside >= 1,
+            "{lifted} vertices lifted, {inside} from inside"
+        );
     }
 
-    #[test]
-    fn a_vertex_inside_a_bone_or_too_near_it_goes_out_along_the_normal_to_its_clearance() {
-        let (lo, hi) = (Vec3::ZERO, Vec3::splat(0.02));
-        let (mesh, surface) = box_bone(BodyId::Thigh, lo, hi);
-        let mut keep = FatKeepOut {
-            vertices: vec![(0, 0.003), (1, 0.003), (2, 0.003)],
-            start: vec![0, 1, 2, 3],
-            bones: vec![0; 3],
+    /// A keep-out of one box bone `0..20 mm` on the thigh for `n` vertices, clearance 3 mm,
+    /// its axis along x through (10, 10, −1000) mm (so away from it is +z at the box).
+    fn box_keep_out(n: usize) -> (FatKeepOut, BoneMesh, (BodyId, TriMesh)) {
+        let (mesh, surface) = box_bone(BodyId::Thigh, Vec3::ZERO, Vec3::splat(0.02));
+        let keep = FatKeepOut {
+            vertices: (0..n as u32).map(|v| (v, 0.003)).collect(),
+            start: (0..=n as u32).collect(),
+            bones: vec![0; n],
             memory: vec![
                 PairMemory {
                     triangle: 0,
                     at: Vec3::ZERO,
                     clear_by: 0.0,
                 };
-                3
+                n
             ],
+            axis: (Vec3::new(0.01, 0.01, -1.0), Vec3::X),
         };
-        // Inside near the top face, just above it, and well clear of it.
+        (keep, mesh, surface)
+    }
+
+    #[test]
+    fn a_free_vertex_inside_a_bone_or_too_near_it_goes_out_to_its_clearance() {
+        let (mut keep, mesh, surface) = box_keep_out(5);
+        // Inside under the top face (away from the axis is up), just above the top face,
+        // just beside the side face x = 20 mm, well clear, and inside but not free.
         let mut x = vec![
-            Vec3::new(0.01, 0.01, 0.019),
+            Vec3::new(0.01, 0.01, 0.015),
             Vec3::new(0.01, 0.01, 0.021),
+            Vec3::new(0.021, 0.01, 0.01),
             Vec3::new(0.01, 0.01, 0.03),
+            Vec3::new(0.01, 0.01, 0.015),
         ];
+        let free = [true, true, true, true, false];
         let pose = |_| (Quat::IDENTITY, Vec3::ZERO);
-        keep.apply(&mut x, &[mesh], &[surface], pose);
+        keep.apply(&mut x, &free, &[mesh], &[surface], pose);
         let top = Vec3::new(0.01, 0.01, 0.023);
         assert!(x[0].distance(top) < 1e-6, "{:?}", x[0]);
         assert!(x[1].distance(top) < 1e-6, "{:?}", x[1]);
-        assert_eq!(x[2], Vec3::new(0.01, 0.01, 0.03));
+        assert!(
+            x[2].distance(Vec3::new(0.023, 0.01, 0.01)) < 1e-6,
+            "{:?}",
+            x[2]
+        );
+        assert_eq!(x[3], Vec3::new(0.01, 0.01, 0.03));
+        assert_eq!(x[4], Vec3::new(0.01, 0.01, 0.015));
+    }
+
+    #[test]
+    fn a_vertex_once_known_clear_is_pushed_when_it_comes_into_the_bone() {
+        let (mut keep, mesh, surface) = box_keep_out(1);
+        let (meshes, surfaces) = ([mesh], [surface]);
+        let pose = |_| (Quat::IDENTITY, Vec3::ZERO);
+        // Far above the box, then nearer step by step, then inside: each time it is kept
+        // at least its clearance out, the remembered ball notwithstanding.
+        for z in [0.06, 0.05, 0.04, 0.03, 0.024, 0.022, 0.01] {
+            let mut x = vec![Vec3::new(0.01, 0.01, z)];
+            keep.apply(&mut x, &[true], &meshes, &surfaces, pose);
+            assert!(x[0].z > 0.023 - 1e-6, "from {z}: {:?}", x[0]);
+            assert_eq!(x[0].z == z, z >= 0.023, "from {z}: {:?}", x[0]);
+        }
     }
 }

@@ -19,6 +19,7 @@ mod muscle_placing;
 pub mod muscle_shape;
 mod phases;
 pub mod polar;
+mod reach;
 mod skin_breach;
 mod skin_cover;
 #[cfg(test)]
@@ -50,7 +51,6 @@ use crate::body::{BodyId, KneeAxis, body_of_bone};
 use crate::error::Result;
 use crate::lattice::{InnerContact, Lattice};
 use crate::muscle::{BodyFrames, MuscleUnit};
-use bone_keep_out::Bones;
 pub use bone_overlap::BoneOverlap;
 use bone_slide::{BoneMesh, BoneSlide};
 use fat_keep_out::FatKeepOut;
@@ -315,62 +315,6 @@ impl Tissue {
         1.0 / self.config.rate_hz
     }
 
-    /// How far each muscle's surface reaches into bone with the bodies at `frames`, in
-    /// muscle order (one tree query per muscle vertex near a bone, and a winding number
-    /// where a bone's surface crosses itself; exact but for points inside one tube of a
-    /// bone whose nearest surface is another tube's wall: for checks, not for every
-    /// update; the first call also finds which bone surfaces cross themselves, about
-    /// 15 ms).
-    pub fn muscles_in_bone(&self, frames: &BodyFrames) -> Vec<BoneOverlap> {
-        let bones = Bones {
-            meshes: &self.fixed.bone_meshes,
-            surfaces: &self.fixed.bones,
-            frames,
-            fade: 1.0,
-            contact: None,
-            cover: None,
-        };
-        let crossed = self.fixed.bones_crossed.get_or_init(|| {
-            self.fixed
-                .bones
-                .par_iter()
-                .map(|(_, m)| intersect::self_intersections(m.vertices(), m.indices()) > 0)
-                .collect()
-        });
-        self.muscles
-            .par_iter()
-            .map(|m| bone_overlap::overlap(&m.current, &bones, crossed))
-            .collect()
-    }
-
-    /// How far each muscle's surface reaches out through the skin now, in muscle order
-    /// (exact: the skin closed at both ends of the lattice, a tree query per muscle
-    /// vertex; for checks, not for every update). None when the skin is degenerate.
-    pub fn muscles_outside_skin(&self) -> Option<Vec<SkinBreach>> {
-        let muscles: Vec<&[Vec3]> = self.muscles.iter().map(|m| m.current.as_slice()).collect();
-        self.fixed.skin.breaches(&self.fat.x, &muscles)
-    }
-
-    /// How far each bone's surface reaches out through the skin with the bodies at
-    /// `frames`, in the lattice's bone order (exact, as
-    /// [`Tissue::muscles_outside_skin`]; for checks, not for every update). None when the
-    /// skin is degenerate.
-    pub fn bones_outside_skin(&self, frames: &BodyFrames) -> Option<Vec<SkinBreach>> {
-        let bones: Vec<Vec<Vec3>> = self
-            .fixed
-            .bones
-            .iter()
-            .map(|(body, m)| {
-                m.vertices()
-                    .iter()
-                    .map(|&p| frames.point(*body, p))
-                    .collect()
-            })
-            .collect();
-        let bones: Vec<&[Vec3]> = bones.iter().map(Vec::as_slice).collect();
-        self.fixed.skin.breaches(&self.fat.x, &bones)
-    }
-
     /// Outer (skin) face of each outer-layer element, with its rest area (m²).
     pub fn outer_faces(&self) -> &[(u32, [u32; 4], f64)] {
         &self.fixed.outer_faces
@@ -556,8 +500,13 @@ impl Tissue {
             pose,
         );
         // The skin in front of the knee lifts over bone the fold brings under it.
-        self.fat_keep_out
-            .apply(&mut self.fat.x, &fixed.bone_meshes, &fixed.bones, pose);
+        self.fat_keep_out.apply(
+            &mut self.fat.x,
+            &self.fat.free,
+            &fixed.bone_meshes,
+            &fixed.bones,
+            pose,
+        );
         self.apply_contact(&contact, gap, &sc.skin_limits);
         self.theta = theta;
         self.scratch = sc;

@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
+use myoslice::muscle::MuscleCatalogue;
 use myoslice::prelude::*;
 
 /// `../shared/data/visible-human/` relative to the workspace.
@@ -153,4 +154,54 @@ pub fn muscles_in_bone_at_build(lattice: &Lattice) -> Vec<(String, usize, f32)> 
         }
     }
     out
+}
+
+/// Drives a flexion to deep flexion with the hamstrings, then back with the quadriceps,
+/// and calls `check` on every tissue update.
+pub fn flex_and_back(sim: &mut Simulation, speed: f64, mut check: impl FnMut(&Simulation)) -> f64 {
+    let flex = [
+        "semitendinosus",
+        "semimembranosus",
+        "biceps_femoris_long",
+        "biceps_femoris_short",
+        "gracilis",
+        "sartorius",
+    ];
+    let ext = [
+        "rectus_femoris",
+        "vastus_lateralis",
+        "vastus_medialis",
+        "vastus_intermedius",
+    ];
+    let mut max_angle = 0.0f64;
+    let period = sim.tissue().unwrap().period();
+    let steps = (1.6 / speed / period).ceil() as usize;
+    for k in 0..steps {
+        let t = k as f64 * period * speed;
+        for m in flex {
+            sim.set_excitation(m, if t < 0.8 { 1.0 } else { 0.0 })
+                .unwrap();
+        }
+        for m in ext {
+            sim.set_excitation(m, if t < 0.8 { 0.0 } else { (0.6 * speed).min(1.0) })
+                .unwrap();
+        }
+        sim.step(period).unwrap();
+        max_angle = max_angle.max(sim.knee_angle());
+        check(sim);
+    }
+    max_angle
+}
+
+/// The Visible Human leg's simulation with the default options (None without the data).
+pub fn visible_human() -> Option<Simulation> {
+    let lattice = vh_lattice()?;
+    Some(
+        Simulation::new(
+            lattice.clone(),
+            SimulationConfig::default(),
+            &MuscleCatalogue::default(),
+        )
+        .unwrap(),
+    )
 }
