@@ -29,8 +29,10 @@ const WATCH_M: f32 = 0.02;
 const SWEEP_STEP_DEG: usize = 5;
 const SWEEP_FROM_DEG: i32 = -30;
 const SWEEP_TO_DEG: i32 = 180;
-/// Farthest (m) a vertex inside a bone looks for its way out.
-const MAX_EXIT_M: f32 = 0.2;
+/// Farthest (m) a vertex inside a bone looks for its way out away from the knee axis,
+/// about a patella's thickness: further, that way runs along a bone (the femur's shaft,
+/// the tibial tuberosity), and the nearest way out serves.
+const MAX_EXIT_M: f32 = 0.03;
 
 /// What a pair last learnt: where its walk starts, and a place (bone frame) its vertex was
 /// known to lie at least so far outside the bone (m; 0 when not known).
@@ -199,13 +201,10 @@ impl FatKeepOut {
                     }
                     let w = mesh.walk_checked(m.triangle, local, tree);
                     let d = w.point.distance(local);
-                    // A settled walk's nearest point may be only local, so it cannot vouch
-                    // for a ball of its own: the ball known before shrinks by how far the
-                    // vertex has gone.
-                    let shrunk = (m.clear_by - local.distance(m.at)).max(0.0);
+                    // A settled walk's nearest point may be only local: it vouches for no
+                    // ball, and the vertex is looked at again next update.
                     (m.triangle, m.at, m.clear_by) = (w.triangle, local, 0.0);
                     if !w.inside && d >= clear {
-                        m.clear_by = shrunk;
                         continue;
                     }
                     let radial = local - axis_at;
@@ -214,14 +213,20 @@ impl FatKeepOut {
                         let toi = tree.cast_local_ray(&Ray::new(local, dir), MAX_EXIT_M, false)?;
                         let exit = local + dir * (toi + clear);
                         // Left through a face aslant the way out: its clearance from the
-                        // nearest point, not along the way.
-                        let near = mesh.walk(w.triangle, exit);
+                        // nearest point, not along the way. Back in the bone (a concave
+                        // part, or a surface that crosses itself): the nearest way out.
+                        let near = mesh.walk_checked(w.triangle, exit, tree);
                         let d = near.point.distance(exit);
-                        Some(if d < clear && !near.inside {
-                            near.point + (exit - near.point) * (clear / d.max(f32::MIN_POSITIVE))
+                        if near.inside {
+                            None
+                        } else if d < clear {
+                            Some(
+                                near.point
+                                    + (exit - near.point) * (clear / d.max(f32::MIN_POSITIVE)),
+                            )
                         } else {
-                            exit
-                        })
+                            Some(exit)
+                        }
                     });
                     let to = exit.unwrap_or_else(|| {
                         let out = if w.inside {
