@@ -276,7 +276,7 @@ def test_bones_outside_skin_per_bone(tissue: Simulation, rigid: Simulation) -> N
     assert count.shape == (n,) and count.dtype == np.int64
     assert farthest.shape == (n,) and farthest.dtype == np.float32
     assert ((farthest > 1e-3) == (count > 0)).all()
-    # The patella lies under the skin at rest, and stays within 3 mm of it bent past 110°
+    # The patella lies under the skin at rest, and stays within 2.5 mm of it bent past 110°
     # (about 119° after 0.3 s; from about 70° it came out, 6.4 mm at 123°, before the fat
     # in front of the knee was kept off bone).
     patella = tissue.bone_names.index("patella")
@@ -284,7 +284,7 @@ def test_bones_outside_skin_per_bone(tissue: Simulation, rigid: Simulation) -> N
     flex(tissue, 0.3)
     assert np.degrees(tissue.knee_angle) > 110.0, np.degrees(tissue.knee_angle)
     r = tissue.bones_outside_skin()
-    assert r["farthest_m"][patella] < 3e-3 and np.isfinite(r["farthest_m"]).all()
+    assert r["farthest_m"][patella] < 2.5e-3 and np.isfinite(r["farthest_m"]).all()
     empty = rigid.bones_outside_skin()
     assert empty["vertices_over_1mm"].shape == (0,) and empty["farthest_m"].shape == (0,)
 

@@ -19,8 +19,10 @@ use super::knee_fold::{FoldZone, KneeFold};
 use crate::body::{BodyId, KneeAxis};
 
 /// Clearance (m) kept from bone per layer above the inner one (the inner layer is not
-/// watched): the skin of a two-layer lattice keeps 3 mm off bone.
-const CLEARANCE_PER_LAYER: f32 = 0.0015;
+/// watched): the skin of a two-layer lattice keeps 5 mm off bone, about the skin and
+/// subcutaneous tissue over the patella (at 3 mm, 6 patella vertices still showed, up
+/// to 2.8 mm, between the skin's vertices; at 5 mm, 2 and 2.0).
+const CLEARANCE_PER_LAYER: f32 = 0.0025;
 /// A pair is watched when, at some knee angle of the sweep, its vertex comes within its
 /// clearance and this much more of the bone (m).
 const WATCH_M: f32 = 0.02;
@@ -47,11 +49,14 @@ pub(crate) struct PairMemory {
 /// learnt.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct FatKeepOut {
-    /// Watched vertices, ascending, with their clearance (m).
-    vertices: Vec<(u32, f32)>,
+    /// Watched vertices, ascending.
+    vertices: Vec<u32>,
     /// Pairs of `vertices[i]`: `bones[start[i]..start[i + 1]]`, bone index ascending.
     start: Vec<u32>,
     bones: Vec<u32>,
+    /// Clearance (m) each pair keeps: its layer's, or its rest distance from the bone
+    /// where that is less (so the rest shape itself is never pushed).
+    clears: Vec<f32>,
     /// What each pair last learnt (parallel to `bones`).
     memory: Vec<PairMemory>,
     /// The knee axis (a point on it and its direction), the same in both bodies' rest
@@ -119,12 +124,19 @@ impl FatKeepOut {
         };
         out.start.push(0);
         for (v, clear, near) in watched {
-            out.vertices.push((v, clear));
+            out.vertices.push(v);
             for b in near {
                 let (mesh, tree) = (&meshes[b as usize], &surfaces[b as usize].1);
+                let at_rest = mesh.walk_from_tree(tree, rest[v as usize]);
+                let rest_d = if at_rest.inside {
+                    0.0
+                } else {
+                    at_rest.point.distance(rest[v as usize])
+                };
                 out.bones.push(b);
+                out.clears.push(clear.min(rest_d));
                 out.memory.push(PairMemory {
-                    triangle: mesh.walk_from_tree(tree, rest[v as usize]).triangle,
+                    triangle: at_rest.triangle,
                     at: Vec3::ZERO,
                     clear_by: 0.0,
                 });
@@ -160,7 +172,8 @@ impl FatKeepOut {
         pose: impl Fn(BodyId) -> (Quat, Vec3) + Sync,
     ) {
         let xs = &*x;
-        let (start, bones, (axis_at, axis)) = (&self.start, &self.bones, self.axis);
+        let (start, bones, clears, (axis_at, axis)) =
+            (&self.start, &self.bones, &self.clears, self.axis);
         // Each vertex's pairs are a contiguous run of `memory`: split it per vertex, so
         // vertices go in parallel and each is written back once, in order.
         let mut runs: Vec<&mut [PairMemory]> = Vec::with_capacity(self.vertices.len());
@@ -175,7 +188,7 @@ impl FatKeepOut {
             .par_iter()
             .zip(runs.into_par_iter())
             .enumerate()
-            .map(|(i, (&(v, clear), memory))| {
+            .map(|(i, (&v, memory))| {
                 if !free[v as usize] {
                     return None;
                 }
@@ -186,6 +199,7 @@ impl FatKeepOut {
                     .enumerate()
                 {
                     let (mesh, tree) = (&meshes[*b as usize], &surfaces[*b as usize].1);
+                    let clear = clears[start[i] as usize + k];
                     let (q, t) = pose(mesh.body());
                     let local = q.inverse() * (p - t);
                     let m = &mut memory[k];
@@ -294,6 +308,9 @@ mod tests {
         rest.push(at(250.0, 0.06));
         let far = rest.len();
         rest.push(at(70.0, 0.20));
+        // Skin 2 mm above the box's top at rest: it keeps those 2 mm, not its layer's.
+        let close = rest.len();
+        rest.push(Vec3::new(0.0, -0.05, 0.052));
         let layer_of = |v: usize| if v == inner { 0 } else { 2 };
         let zone = FoldZone::new(&knee, &rest, &[]);
         let meshes = [mesh];
@@ -301,8 +318,13 @@ mod tests {
         let mut keep = FatKeepOut::new(&knee, &rest, &zone, layer_of, &meshes, &surfaces);
         // The arc's skin near the box, not the inner vertex, the skin behind the knee nor
         // the skin far off.
-        let watched: Vec<u32> = keep.vertices.iter().map(|v| v.0).collect();
-        assert!(watched.iter().all(|&v| (v as usize) < inner), "{watched:?}");
+        let watched: Vec<u32> = keep.vertices.clone();
+        assert!(
+            watched
+                .iter()
+                .all(|&v| (v as usize) < inner || v as usize == close),
+            "{watched:?}"
+        );
         assert!(watched.len() >= 4, "{watched:?}");
         assert!(
             [inner, behind, far]
@@ -311,6 +333,12 @@ mod tests {
         );
         let clear = 2.0 * CLEARANCE_PER_LAYER;
         let free = vec![true; rest.len()];
+        // At rest nothing moves.
+        let mut x = rest.clone();
+        let pose = |_| (Quat::IDENTITY, Vec3::ZERO);
+        keep.apply(&mut x, &free, &meshes, &surfaces, pose);
+        assert_eq!(x, rest);
+        assert!(watched.contains(&(close as u32)));
         let (mut inside, mut lifted) = (0, 0);
         for deg in (1..=30).map(|k| 5.0 * k as f32) {
             let theta = deg.to_radians();
@@ -356,9 +384,10 @@ mod tests {
     fn box_keep_out(n: usize) -> (FatKeepOut, BoneMesh, (BodyId, TriMesh)) {
         let (mesh, surface) = box_bone(BodyId::Thigh, Vec3::ZERO, Vec3::splat(0.02));
         let keep = FatKeepOut {
-            vertices: (0..n as u32).map(|v| (v, 0.003)).collect(),
+            vertices: (0..n as u32).collect(),
             start: (0..=n as u32).collect(),
             bones: vec![0; n],
+            clears: vec![0.003; n],
             memory: vec![
                 PairMemory {
                     triangle: 0,
