@@ -78,6 +78,7 @@ class Simulation:
         tendon: str = "rigid",
         tissue: bool = True,
         tissue_rate_hz: float = 30.0,
+        tissue_iterations: int | None = None,
         initial_knee_deg: float = 0.0,
         max_step_s: float = 0.001,
         chain_tether: float | None = None,
@@ -90,6 +91,9 @@ class Simulation:
         ``"compliant"`` (the Hill units' tendons stretch, and the fibre length becomes a
         state found every step); ``tissue=False`` skips the
         deformable fat and muscle volumes (faster; the tissue arrays are then empty).
+        ``tissue_rate_hz`` (tissue updates per simulated second) and
+        ``tissue_iterations`` (shape-matching iterations per update; ``None``: the
+        default, 6) trade the tissue's smoothness for speed (the README's table).
         ``chain_tether`` (N/m) pulls each relaxed muscle's chain points toward where they
         rest on their bones (``None``: the default, 600; ``0``: the paper's free chain),
         fading out as the muscle's force rises to ``chain_tether_release_n`` (N; ``None``:
@@ -109,6 +113,7 @@ class Simulation:
         tendon: str = "rigid",
         tissue: bool = True,
         tissue_rate_hz: float = 30.0,
+        tissue_iterations: int | None = None,
         initial_knee_deg: float = 0.0,
         max_step_s: float = 0.001,
         chain_tether: float | None = None,

@@ -13,6 +13,8 @@ pub(crate) struct ConfigArgs<'a> {
     pub(crate) tendon: &'a str,
     pub(crate) tissue: bool,
     pub(crate) tissue_rate_hz: f64,
+    /// None: the core's default.
+    pub(crate) tissue_iterations: Option<usize>,
     pub(crate) initial_knee_deg: f64,
     pub(crate) max_step_s: f64,
     /// None: the core's default.
@@ -42,6 +44,7 @@ impl ConfigArgs<'_> {
         };
         c.tissue.enabled = self.tissue;
         c.tissue.rate_hz = self.tissue_rate_hz;
+        c.tissue.iterations = self.tissue_iterations.unwrap_or(c.tissue.iterations);
         c.validate().or_py(py)?;
         Ok(c)
     }

@@ -68,7 +68,7 @@ fn gpu(py: Python<'_>) -> PyResult<&'static Gpu> {
 impl PySimulation {
     /// The built-in lower-limb phantom (no files needed). Units are SI.
     #[staticmethod]
-    #[pyo3(signature = (*, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, chain_tether_release_n = None, voxel_mm = None))]
+    #[pyo3(signature = (*, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, tissue_iterations = None, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, chain_tether_release_n = None, voxel_mm = None))]
     #[allow(clippy::too_many_arguments)]
     fn phantom(
         py: Python<'_>,
@@ -78,6 +78,7 @@ impl PySimulation {
         tendon: &str,
         tissue: bool,
         tissue_rate_hz: f64,
+        tissue_iterations: Option<usize>,
         initial_knee_deg: f64,
         max_step_s: f64,
         chain_tether: Option<f64>,
@@ -91,6 +92,7 @@ impl PySimulation {
             tendon,
             tissue,
             tissue_rate_hz,
+            tissue_iterations,
             initial_knee_deg,
             max_step_s,
             chain_tether,
@@ -112,7 +114,7 @@ impl PySimulation {
 
     /// A NIfTI label volume with its label table (JSON or TOML).
     #[staticmethod]
-    #[pyo3(signature = (volume, labels, *, slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, chain_tether_release_n = None))]
+    #[pyo3(signature = (volume, labels, *, slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, tissue_iterations = None, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, chain_tether_release_n = None))]
     #[allow(clippy::too_many_arguments)]
     fn from_nifti(
         py: Python<'_>,
@@ -126,6 +128,7 @@ impl PySimulation {
         tendon: &str,
         tissue: bool,
         tissue_rate_hz: f64,
+        tissue_iterations: Option<usize>,
         initial_knee_deg: f64,
         max_step_s: f64,
         chain_tether: Option<f64>,
@@ -140,6 +143,7 @@ impl PySimulation {
             tendon,
             tissue,
             tissue_rate_hz,
+            tissue_iterations,
             initial_knee_deg,
             max_step_s,
             chain_tether,

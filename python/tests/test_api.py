@@ -478,6 +478,23 @@ def test_tissue_elements_do_not_invert(tissue: Simulation) -> None:
     )
 
 
+def test_tissue_rate_and_iterations_are_applied(tissue: Simulation) -> None:
+    # Fewer shape-matching iterations leave the fat less relaxed: another skin.
+    fewer = Simulation.phantom(tissue_iterations=1)
+    for sim in (tissue, fewer):
+        sim.reset_timers()
+        flex(sim, 0.1)
+    skin, _ = tissue.surface("skin")
+    skin_fewer, _ = fewer.surface("skin")
+    assert skin.shape == skin_fewer.shape
+    assert float(np.abs(skin - skin_fewer).max()) > 1e-5
+    # A third of the rate: a third of the updates.
+    slower = Simulation.phantom(tissue_rate_hz=10.0)
+    slower.reset_timers()
+    flex(slower, 0.1)
+    assert (tissue.timers["tissue_updates"], slower.timers["tissue_updates"]) == (3, 1)
+
+
 def test_tissue_arrays_without_tissue(rigid: Simulation) -> None:
     flex(rigid, 0.05)
     for name in (*PER_FAT_F32, "muscle_volume_ratio"):

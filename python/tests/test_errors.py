@@ -165,6 +165,8 @@ def test_bad_set_knee(rigid: Simulation, angle: float, velocity: float) -> None:
         {"chain_tether": math.nan},
         {"chain_tether_release_n": -1.0},
         {"chain_tether_release_n": math.inf},
+        {"tissue_rate_hz": 0.0},
+        {"tissue_iterations": 0},
     ],
     ids=lambda kw: next(iter(kw)),
 )

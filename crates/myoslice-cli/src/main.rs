@@ -66,6 +66,12 @@ struct BenchArgs {
     /// Runs of each case; the fastest is reported.
     #[arg(long, default_value_t = 3)]
     runs: usize,
+    /// Tissue updates per simulated second for `whole_leg_step` (default 30).
+    #[arg(long)]
+    tissue_rate: Option<f64>,
+    /// Shape-matching iterations per tissue update for `whole_leg_step` (default 6).
+    #[arg(long)]
+    tissue_iterations: Option<usize>,
 }
 
 #[derive(Args)]
@@ -373,6 +379,8 @@ fn run(cli: &Cli) -> Result<()> {
             visible_human: a.visible_human.as_deref(),
             only: a.only.as_deref(),
             runs: a.runs,
+            tissue_rate_hz: a.tissue_rate,
+            tissue_iterations: a.tissue_iterations,
         }),
         Command::Probe(a) => probe(a),
         Command::Slices(a) => {
