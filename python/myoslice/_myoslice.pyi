@@ -93,7 +93,7 @@ class Simulation:
         deformable fat and muscle volumes (faster; the tissue arrays are then empty).
         ``tissue_rate_hz`` (tissue updates per simulated second) and
         ``tissue_iterations`` (shape-matching iterations per update; ``None``: the
-        default, 6) trade the tissue's smoothness for speed (the README's table).
+        library's default) trade the tissue's smoothness for speed (the README's table).
         ``chain_tether`` (N/m) pulls each relaxed muscle's chain points toward where they
         rest on their bones (``None``: the default, 600; ``0``: the paper's free chain),
         fading out as the muscle's force rises to ``chain_tether_release_n`` (N; ``None``:

@@ -3,7 +3,7 @@
 use myoslice::prelude::*;
 use pyo3::prelude::*;
 
-use crate::errors::OrPy;
+use crate::errors::{Kind, OrPy, py_err};
 
 /// The keyword arguments `Simulation.phantom` and `Simulation.from_nifti` share.
 pub(crate) struct ConfigArgs<'a> {
@@ -13,8 +13,9 @@ pub(crate) struct ConfigArgs<'a> {
     pub(crate) tendon: &'a str,
     pub(crate) tissue: bool,
     pub(crate) tissue_rate_hz: f64,
-    /// None: the core's default.
-    pub(crate) tissue_iterations: Option<usize>,
+    /// None: the core's default. Signed, so that a negative count gets the same
+    /// `InvalidInputError` as zero rather than an `OverflowError`.
+    pub(crate) tissue_iterations: Option<i64>,
     pub(crate) initial_knee_deg: f64,
     pub(crate) max_step_s: f64,
     /// None: the core's default.
@@ -44,7 +45,15 @@ impl ConfigArgs<'_> {
         };
         c.tissue.enabled = self.tissue;
         c.tissue.rate_hz = self.tissue_rate_hz;
-        c.tissue.iterations = self.tissue_iterations.unwrap_or(c.tissue.iterations);
+        if let Some(n) = self.tissue_iterations {
+            c.tissue.iterations = usize::try_from(n).map_err(|_| {
+                py_err(
+                    py,
+                    Kind::Invalid,
+                    format!("tissue_iterations = {n}: expected at least one iteration"),
+                )
+            })?;
+        }
         c.validate().or_py(py)?;
         Ok(c)
     }

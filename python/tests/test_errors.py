@@ -167,6 +167,7 @@ def test_bad_set_knee(rigid: Simulation, angle: float, velocity: float) -> None:
         {"chain_tether_release_n": math.inf},
         {"tissue_rate_hz": 0.0},
         {"tissue_iterations": 0},
+        {"tissue_iterations": -1},
     ],
     ids=lambda kw: next(iter(kw)),
 )

@@ -127,6 +127,19 @@ pub struct BenchOptions<'a> {
 pub fn run(o: &BenchOptions) -> Result<()> {
     let wanted = |name: &str| o.only.is_none_or(|w| name.contains(w));
     let runs = o.runs.max(1);
+    // The whole leg's tissue options, checked before any case runs. Slower updates or
+    // fewer iterations trade the tissue's smoothness for speed (the README's table).
+    let mut leg = SimulationConfig::default();
+    leg.tissue.rate_hz = o.tissue_rate_hz.unwrap_or(leg.tissue.rate_hz);
+    leg.tissue.iterations = o.tissue_iterations.unwrap_or(leg.tissue.iterations);
+    leg.validate()?;
+    if (o.tissue_rate_hz.is_some() || o.tissue_iterations.is_some()) && !wanted("whole_leg_step") {
+        anyhow::bail!(
+            "--tissue-rate and --tissue-iterations apply to whole_leg_step, which --only '{}' \
+             leaves out",
+            o.only.unwrap_or_default()
+        );
+    }
     let mut cases = Vec::new();
     if wanted("build_phantom") {
         let (t, lat) = best_of(runs, || {
@@ -202,16 +215,11 @@ pub fn run(o: &BenchOptions) -> Result<()> {
         }
     }
     if wanted("whole_leg_step") {
-        // Slower updates or fewer iterations trade the tissue's smoothness for speed
-        // (the README's table); the library checks the values.
-        let mut cfg = SimulationConfig::default();
-        cfg.tissue.rate_hz = o.tissue_rate_hz.unwrap_or(cfg.tissue.rate_hz);
-        cfg.tissue.iterations = o.tissue_iterations.unwrap_or(cfg.tissue.iterations);
         let note = format!(
             "all muscles, tissue at {} Hz x {} iterations, 1 ms",
-            cfg.tissue.rate_hz, cfg.tissue.iterations
+            leg.tissue.rate_hz, leg.tissue.iterations
         );
-        cases.push(knee_case("whole_leg_step", cfg, &FLEXORS, &note, runs)?);
+        cases.push(knee_case("whole_leg_step", leg, &FLEXORS, &note, runs)?);
     }
     if cases.is_empty() {
         anyhow::bail!(

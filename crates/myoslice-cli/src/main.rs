@@ -66,10 +66,11 @@ struct BenchArgs {
     /// Runs of each case; the fastest is reported.
     #[arg(long, default_value_t = 3)]
     runs: usize,
-    /// Tissue updates per simulated second for `whole_leg_step` (default 30).
+    /// Tissue updates per simulated second for `whole_leg_step` (default: the library's).
     #[arg(long)]
     tissue_rate: Option<f64>,
-    /// Shape-matching iterations per tissue update for `whole_leg_step` (default 6).
+    /// Shape-matching iterations per tissue update for `whole_leg_step` (default: the
+    /// library's).
     #[arg(long)]
     tissue_iterations: Option<usize>,
 }

@@ -4,7 +4,7 @@
 //! `myoslice bench --only whole_leg --tissue-rate R --tissue-iterations N`.
 //!
 //! ```text
-//! cargo run --release -p myoslice --example tissue_rates -- 30:6 10:6
+//! cargo run --release -p myoslice --example tissue_rates -- 30:6 30:4 20:6 15:6 10:6 10:4
 //! ```
 
 #[path = "../tests/common/mod.rs"]
@@ -14,18 +14,18 @@ use std::error::Error;
 
 use myoslice::muscle::MuscleCatalogue;
 use myoslice::prelude::*;
-use myoslice::tissue::intersect::self_intersections;
 
 /// The worst of each check over a flexion.
 #[derive(Default)]
 struct Worst {
     inverted: usize,
     crossings: usize,
+    finite: bool,
     volume: (f32, f32),
     out: usize,
     out_m: f32,
     /// Muscle vertices in bone beyond those at rest, and the deepest of muscles deeper
-    /// than at rest.
+    /// than at rest (as the tests count them).
     in_bone: usize,
     in_bone_m: f32,
     bones_out: Vec<usize>,
@@ -41,42 +41,27 @@ fn measure(
     cfg.tissue.iterations = iterations;
     let mut sim = Simulation::new(lattice.clone(), cfg, &MuscleCatalogue::default())?;
     let triangles = sim.lattice().fat.surface_triangles();
-    // Muscle and bone overlap where the slices let them at rest: counted as the tests
-    // count them, beyond that.
-    let rest = sim.muscles_in_bone().unwrap_or_default();
-    let at_rest: usize = rest.iter().map(|o| o.vertices_over_1mm).sum();
+    let rest = sim.muscles_in_bone().ok_or("no tissue")?;
     let mut w = Worst {
+        finite: true,
         volume: (1.0, 1.0),
         bones_out: vec![0; sim.lattice().bones.len()],
         ..Worst::default()
     };
+    // The helpers fail loudly (a skin that cannot be closed is not zero vertices out).
     let top = common::flex_and_back(&mut sim, 1.0, |s| {
-        let (Some(t), Some(m)) = (s.tissue(), s.tissue_metrics()) else {
-            return;
-        };
-        w.inverted = w.inverted.max(m.inverted);
-        for r in &m.muscle_volume_ratio {
+        let (inverted, crossings, finite) = common::tissue_breaks(s, &triangles);
+        (w.inverted, w.crossings) = (w.inverted.max(inverted), w.crossings.max(crossings));
+        w.finite &= finite;
+        for r in &s.tissue_metrics().expect("tissue").muscle_volume_ratio {
             w.volume = (w.volume.0.min(*r), w.volume.1.max(*r));
         }
-        w.crossings = w
-            .crossings
-            .max(self_intersections(t.fat_vertices(), &triangles));
-        let out = s.muscles_outside_skin().unwrap_or_default();
-        w.out = w.out.max(out.iter().map(|b| b.vertices_over_1mm).sum());
-        w.out_m = out.iter().map(|b| b.farthest_m).fold(w.out_m, f32::max);
-        let in_bone = s.muscles_in_bone().unwrap_or_default();
-        let count: usize = in_bone.iter().map(|b| b.vertices_over_1mm).sum();
-        w.in_bone = w.in_bone.max(count.saturating_sub(at_rest));
-        for (now, r) in in_bone.iter().zip(&rest) {
-            if now.deepest_m > r.deepest_m {
-                w.in_bone_m = w.in_bone_m.max(now.deepest_m);
-            }
-        }
-        for (most, b) in w
-            .bones_out
-            .iter_mut()
-            .zip(s.bones_outside_skin().unwrap_or_default())
-        {
+        let (out, out_m) = common::muscles_out(s);
+        (w.out, w.out_m) = (w.out.max(out), w.out_m.max(out_m));
+        let (in_bone, in_bone_m) = common::muscles_in_bone_beyond(s, &rest);
+        (w.in_bone, w.in_bone_m) = (w.in_bone.max(in_bone), w.in_bone_m.max(in_bone_m));
+        let bones = s.bones_outside_skin().expect("a closed skin");
+        for (most, b) in w.bones_out.iter_mut().zip(bones) {
             *most = (*most).max(b.vertices_over_1mm);
         }
     });
@@ -93,8 +78,9 @@ fn main() -> Result<(), Box<dyn Error>> {
     let lattice = common::phantom_lattice();
     let bones: Vec<&str> = lattice.bones.iter().map(|b| b.name.as_str()).collect();
     println!(
-        "rate Hz  iterations  deepest at an update  inverted  crossing pairs  muscle volume ratio  \
-         muscle vertices out (farthest)  in bone beyond rest (deepest)  bone vertices out"
+        "rate Hz  iterations  deepest at an update  inverted  crossing pairs  all finite  \
+         muscle volume ratio  muscle vertices out (farthest)  in bone beyond rest (deepest)  \
+         bone vertices out"
     );
     for case in &cases {
         let parsed = case
@@ -111,10 +97,11 @@ fn main() -> Result<(), Box<dyn Error>> {
             .map(|(b, n)| format!("{b} {n}"))
             .collect();
         println!(
-            "{rate:7} {iterations:11} {:20.1}° {:9} {:15} [{:.4}, {:.4}] {:17} ({:.1} mm) {:9} ({:.1} mm)  {}",
+            "{rate:7} {iterations:11} {:20.1}° {:9} {:15} {:11} [{:.4}, {:.4}] {:17} ({:.1} mm) {:9} ({:.1} mm)  {}",
             top.to_degrees(),
             w.inverted,
             w.crossings,
+            w.finite,
             w.volume.0,
             w.volume.1,
             w.out,

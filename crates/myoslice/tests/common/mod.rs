@@ -205,3 +205,44 @@ pub fn visible_human() -> Option<Simulation> {
         .unwrap(),
     )
 }
+
+/// After the last tissue update: inverted fat elements, crossing pairs among the skin's
+/// `triangles` (`sim.lattice().fat.surface_triangles()`), and whether every fat vertex
+/// is finite.
+pub fn tissue_breaks(sim: &Simulation, triangles: &[[u32; 3]]) -> (usize, usize, bool) {
+    let t = sim.tissue().unwrap();
+    let x = t.fat_vertices();
+    (
+        sim.tissue_metrics().unwrap().inverted,
+        myoslice::tissue::intersect::self_intersections(x, triangles),
+        x.iter().all(|p| p.is_finite()),
+    )
+}
+
+/// Muscle vertices more than 1 mm out through the skin now, and the farthest (m).
+pub fn muscles_out(sim: &Simulation) -> (usize, f32) {
+    let out = sim.muscles_outside_skin().unwrap();
+    (
+        out.iter().map(|b| b.vertices_over_1mm).sum(),
+        out.iter().map(|b| b.farthest_m).fold(0.0, f32::max),
+    )
+}
+
+/// Muscle vertices more than 1 mm inside bone now beyond the `rest` count (the slices
+/// let muscle and bone overlap at rest), and the deepest of the muscles that reach
+/// deeper than at `rest` (m; 0 when none does).
+pub fn muscles_in_bone_beyond(
+    sim: &Simulation,
+    rest: &[myoslice::tissue::BoneOverlap],
+) -> (usize, f32) {
+    let now = sim.muscles_in_bone().unwrap();
+    let count: usize = now.iter().map(|o| o.vertices_over_1mm).sum();
+    let at_rest: usize = rest.iter().map(|o| o.vertices_over_1mm).sum();
+    let deepest = now
+        .iter()
+        .zip(rest)
+        .filter(|(n, r)| n.deepest_m > r.deepest_m)
+        .map(|(n, _)| n.deepest_m)
+        .fold(0.0, f32::max);
+    (count.saturating_sub(at_rest), deepest)
+}
