@@ -294,7 +294,7 @@ impl UiState {
             if let Some(m) = sim.tissue_metrics() {
                 ui.label("tissue");
                 ui.label(format!(
-                    "min vol {:.2}, max |ΔA| {:.2}, inverted {}",
+                    "min vol {:.2}, max |ΔA| {:.2}, folded (VTK) {}",
                     m.min_volume_ratio, m.max_abs_area_change, m.inverted
                 ));
                 ui.end_row();

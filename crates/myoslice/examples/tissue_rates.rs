@@ -18,6 +18,8 @@ use myoslice::prelude::*;
 /// The worst of each check over a flexion.
 #[derive(Default)]
 struct Worst {
+    /// Elements with a folded corner (VTK's test), and of non-positive volume.
+    folded: usize,
     inverted: usize,
     crossings: usize,
     finite: bool,
@@ -50,9 +52,10 @@ fn measure(
     };
     // The helpers fail loudly (a skin that cannot be closed is not zero vertices out).
     let top = common::flex_and_back(&mut sim, 1.0, |s| {
-        let (inverted, crossings, finite) = common::tissue_breaks(s, &triangles);
-        (w.inverted, w.crossings) = (w.inverted.max(inverted), w.crossings.max(crossings));
-        w.finite &= finite;
+        let b = common::tissue_breaks(s, &triangles);
+        w.folded = w.folded.max(b.folded);
+        (w.inverted, w.crossings) = (w.inverted.max(b.inverted), w.crossings.max(b.crossings));
+        w.finite &= b.finite;
         for r in &s.tissue_metrics().expect("tissue").muscle_volume_ratio {
             w.volume = (w.volume.0.min(*r), w.volume.1.max(*r));
         }
@@ -78,7 +81,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     let lattice = common::phantom_lattice();
     let bones: Vec<&str> = lattice.bones.iter().map(|b| b.name.as_str()).collect();
     println!(
-        "rate Hz  iterations  deepest at an update  inverted  crossing pairs  all finite  \
+        "rate Hz  iterations  deepest at an update  folded  inverted  crossing pairs  all finite  \
          muscle volume ratio  muscle vertices out (farthest)  in bone beyond rest (deepest)  \
          bone vertices out"
     );
@@ -97,8 +100,9 @@ fn main() -> Result<(), Box<dyn Error>> {
             .map(|(b, n)| format!("{b} {n}"))
             .collect();
         println!(
-            "{rate:7} {iterations:11} {:20.1}° {:9} {:15} {:11} [{:.4}, {:.4}] {:17} ({:.1} mm) {:9} ({:.1} mm)  {}",
+            "{rate:7} {iterations:11} {:20.1}° {:7} {:9} {:15} {:11} [{:.4}, {:.4}] {:17} ({:.1} mm) {:9} ({:.1} mm)  {}",
             top.to_degrees(),
+            w.folded,
             w.inverted,
             w.crossings,
             w.finite,

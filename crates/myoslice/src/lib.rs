@@ -15,6 +15,7 @@ pub mod body;
 pub mod contour;
 pub mod error;
 pub mod export;
+pub mod geometry;
 pub mod io;
 pub mod label_table;
 pub mod label_volume;

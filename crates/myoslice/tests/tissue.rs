@@ -146,44 +146,73 @@ fn muscle_volume_is_conserved_through_a_deep_flexion_of_the_visible_human_leg() 
 }
 
 /// Flexes `sim` to deep flexion and back at `speed` × the tests' excitation speed,
-/// asserting that no fat element inverts, the skin never crosses itself and every fat
-/// vertex stays finite after every update; returns the largest knee angle after one.
-fn tissue_never_breaks(mut sim: Simulation, speed: f64) -> f64 {
+/// asserting after every update that no fat element turns inside out, the skin never
+/// crosses itself and every fat vertex stays finite; and that no more fat elements have a
+/// folded corner (ParaView's test of a valid hexahedron) than `folded.0` at any update
+/// and `folded.1` once the knee is straight again. Returns the largest knee angle after
+/// an update.
+///
+/// The folds are a regression bound, not a goal: the special-case tissue passes leave
+/// them (the guard that undoes them pushed muscles out through the skin, see
+/// docs/tissue-history.md), and the contact-aware tissue solver is to end them.
+fn tissue_never_breaks(mut sim: Simulation, speed: f64, folded: (usize, usize)) -> f64 {
     let tri = sim.lattice().fat.surface_triangles();
-    let (mut inverted, mut crossings, mut finite) = (0usize, 0usize, true);
+    let mut worst = common::Breaks {
+        finite: true,
+        ..Default::default()
+    };
+    let mut last = worst;
     let max = common::flex_and_back(&mut sim, speed, |s| {
-        let (i, c, f) = common::tissue_breaks(s, &tri);
-        (inverted, crossings, finite) = (inverted.max(i), crossings.max(c), finite && f);
+        let b = common::tissue_breaks(s, &tri);
+        worst = common::Breaks {
+            folded: worst.folded.max(b.folded),
+            inverted: worst.inverted.max(b.inverted),
+            crossings: worst.crossings.max(b.crossings),
+            finite: worst.finite && b.finite,
+        };
+        last = b;
     });
-    assert!(finite, "a fat vertex became non-finite");
+    eprintln!(
+        "at most {} fat elements with a folded corner ({} at the end, knee at {:.1}°)",
+        worst.folded,
+        last.folded,
+        sim.knee_angle().to_degrees()
+    );
+    assert!(worst.finite, "a fat vertex became non-finite");
     assert_eq!(
-        (inverted, crossings),
+        (worst.inverted, worst.crossings),
         (0, 0),
         "inverted elements, self-intersecting skin triangle pairs"
+    );
+    assert!(
+        worst.folded <= folded.0 && last.folded <= folded.1,
+        "{} fat elements with a folded corner, {} at the end: more than the {folded:?} recorded",
+        worst.folded,
+        last.folded
     );
     max.to_degrees()
 }
 
 /// [`tissue_never_breaks`] with the default options on `lattice`, reaching past 125°.
-fn tissue_never_breaks_on(lattice: Lattice, speed: f64) {
+fn tissue_never_breaks_on(lattice: Lattice, speed: f64, folded: (usize, usize)) {
     let sim = Simulation::new(
         lattice,
         SimulationConfig::default(),
         &MuscleCatalogue::default(),
     )
     .unwrap();
-    let max = tissue_never_breaks(sim, speed);
+    let max = tissue_never_breaks(sim, speed, folded);
     assert!(max > 125.0, "the flexion reached only {max:.1}°");
 }
 
 #[test]
 fn fat_never_inverts_nor_self_intersects_through_a_deep_flexion() {
-    tissue_never_breaks_on(common::phantom_lattice().clone(), 1.0);
+    tissue_never_breaks_on(common::phantom_lattice().clone(), 1.0, (750, 35));
 }
 
 #[test]
 fn fat_never_inverts_nor_self_intersects_at_three_times_the_speed() {
-    tissue_never_breaks_on(common::phantom_lattice().clone(), 3.0);
+    tissue_never_breaks_on(common::phantom_lattice().clone(), 3.0, (750, 85));
 }
 
 /// The README's table of tissue rates offers a third of the default rate as a trade of
@@ -193,7 +222,7 @@ fn fat_never_inverts_nor_self_intersects_at_a_third_of_the_tissue_rate() {
     let mut cfg = SimulationConfig::default();
     cfg.tissue.rate_hz /= 3.0;
     let sim = Simulation::phantom(cfg).unwrap();
-    let max = tissue_never_breaks(sim, 1.0);
+    let max = tissue_never_breaks(sim, 1.0, (575, 35));
     // Updates 0.1 s apart fall at most at 123° of the flexion's 134°.
     assert!(
         max > 120.0,
@@ -206,7 +235,7 @@ fn visible_human_fat_never_inverts_nor_self_intersects_through_a_deep_flexion() 
     let Some(lattice) = common::vh_lattice() else {
         return;
     };
-    tissue_never_breaks_on(lattice.clone(), 1.0);
+    tissue_never_breaks_on(lattice.clone(), 1.0, (750, 45));
 }
 
 #[test]
@@ -214,7 +243,7 @@ fn visible_human_fat_never_inverts_nor_self_intersects_at_three_times_the_speed(
     let Some(lattice) = common::vh_lattice() else {
         return;
     };
-    tissue_never_breaks_on(lattice.clone(), 3.0);
+    tissue_never_breaks_on(lattice.clone(), 3.0, (750, 90));
 }
 
 /// Flexes `sim` to about 130° and back; returns how many muscle vertices lay more than

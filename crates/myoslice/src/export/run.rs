@@ -47,8 +47,11 @@ pub struct RunSummary {
     pub max_abs_area_change: f64,
     /// Smallest and largest muscle volume ratio over the frames.
     pub muscle_volume_ratio_range: [f64; 2],
-    /// Most inverted fat elements in one frame.
+    /// Most fat elements with a folded corner in one frame (a corner Jacobian at or below
+    /// zero: the hexahedra ParaView's and VTK's quality filters call invalid).
     pub inverted_elements: usize,
+    /// Fat elements with a folded corner in the last frame (whether the fat came back).
+    pub final_inverted_elements: usize,
     /// Wall time of the run (s).
     pub wall_time_s: f64,
     /// Simulated seconds per wall second.
@@ -114,6 +117,7 @@ impl RunWriter {
                 max_abs_area_change: 0.0,
                 muscle_volume_ratio_range: [1.0, 1.0],
                 inverted_elements: 0,
+                final_inverted_elements: 0,
                 wall_time_s: 0.0,
                 realtime_factor: 0.0,
                 muscles_wall_time_s: 0.0,
@@ -158,6 +162,7 @@ impl RunWriter {
             s.min_fat_volume_ratio = s.min_fat_volume_ratio.min(f64::from(m.min_volume_ratio));
             s.max_abs_area_change = s.max_abs_area_change.max(f64::from(m.max_abs_area_change));
             s.inverted_elements = s.inverted_elements.max(m.inverted);
+            s.final_inverted_elements = m.inverted;
             for r in &m.muscle_volume_ratio {
                 s.muscle_volume_ratio_range = [
                     s.muscle_volume_ratio_range[0].min(f64::from(*r)),

@@ -6,6 +6,7 @@ mod builder;
 pub mod checks;
 pub mod fat;
 pub mod frame;
+mod hex_quality;
 pub mod triangulate;
 pub mod tube;
 
@@ -16,6 +17,7 @@ pub use builder::BuildOptions;
 pub use checks::{InvariantReport, oriented_trimesh, strictly_inside, winding_number};
 pub use fat::{FatLattice, InnerContact, hex_volume, hex_volume_f32, hex_volume_points, quad_area};
 pub use frame::SliceFrame;
+pub use hex_quality::{corner_jacobians, hex_is_valid, min_corner_jacobian};
 pub use tube::{Ring, RingInput, Slab, TubeMesh, check_closed, signed_volume};
 
 use crate::label_table::{LabelTable, TissueKind};

@@ -8,7 +8,7 @@ use super::Tissue;
 use rayon::prelude::*;
 
 use super::polar::{covariance, polar_rotation_exact, rotation_step};
-use crate::lattice::{hex_volume_f32, quad_area};
+use crate::lattice::{hex_is_valid, hex_volume_f32, quad_area};
 
 /// Metrics of the tissue at one moment; arrays are contiguous, one value per fat
 /// hexahedron (lattice order) or per muscle (simulation order).
@@ -28,8 +28,13 @@ pub struct TissueMetrics {
     pub min_volume_ratio: f32,
     /// Largest |area change|.
     pub max_abs_area_change: f32,
-    /// Elements of zero or negative volume.
+    /// Elements with a folded corner: a corner Jacobian at or below zero (ParaView's and
+    /// VTK's test of a valid hexahedron; an element can fold at a corner and keep a
+    /// positive volume). Every element is tested, whichever were measured.
     pub inverted: usize,
+    /// Elements of zero or negative volume (turned inside out as a whole; each is also
+    /// counted in [`Self::inverted`]).
+    pub negative_volume: usize,
     /// Fat vertices the validity guard moved off the relaxed shape toward the knee fold
     /// in the last update (0: the elastic relaxation stood everywhere).
     pub guarded_vertices: usize,
@@ -81,7 +86,13 @@ impl TissueMetrics {
             .collect();
         let volume_ratio: Vec<f32> = per.iter().map(|p| p.0).collect();
         let degree: Vec<f32> = per.iter().map(|p| p.1).collect();
-        let inverted = volume_ratio.iter().filter(|&&r| r <= 0.0).count();
+        // Every element, also those that moved with a bone: a fold may leave one folded.
+        let inverted = fat
+            .hexes
+            .par_iter()
+            .filter(|h| !hex_is_valid(&fat.x, h))
+            .count();
+        let negative_volume = volume_ratio.iter().filter(|&&r| r <= 0.0).count();
         let mut area_change = vec![0.0f32; n];
         for &(h, quad, a0) in t.outer_faces() {
             if measured(h as usize) && a0 > 0.0 {
@@ -101,6 +112,7 @@ impl TissueMetrics {
             volume_ratio,
             muscle_volume_ratio,
             inverted,
+            negative_volume,
             guarded_vertices: 0,
         }
     }

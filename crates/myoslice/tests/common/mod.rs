@@ -206,17 +206,32 @@ pub fn visible_human() -> Option<Simulation> {
     )
 }
 
-/// After the last tissue update: inverted fat elements, crossing pairs among the skin's
-/// `triangles` (`sim.lattice().fat.surface_triangles()`), and whether every fat vertex
-/// is finite.
-pub fn tissue_breaks(sim: &Simulation, triangles: &[[u32; 3]]) -> (usize, usize, bool) {
+/// How broken the tissue is after the last tissue update.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Breaks {
+    /// Fat elements with a folded corner (VTK's test of a valid hexahedron).
+    pub folded: usize,
+    /// Fat elements of zero or negative volume.
+    pub inverted: usize,
+    /// Crossing pairs among the skin's triangles.
+    pub crossings: usize,
+    /// Whether every fat vertex is finite.
+    pub finite: bool,
+}
+
+/// After the last tissue update: folded and inverted fat elements, crossing pairs among
+/// the skin's `triangles` (`sim.lattice().fat.surface_triangles()`), and whether every
+/// fat vertex is finite.
+pub fn tissue_breaks(sim: &Simulation, triangles: &[[u32; 3]]) -> Breaks {
     let t = sim.tissue().unwrap();
     let x = t.fat_vertices();
-    (
-        sim.tissue_metrics().unwrap().inverted,
-        myoslice::tissue::intersect::self_intersections(x, triangles),
-        x.iter().all(|p| p.is_finite()),
-    )
+    let m = sim.tissue_metrics().unwrap();
+    Breaks {
+        folded: m.inverted,
+        inverted: m.negative_volume,
+        crossings: myoslice::tissue::intersect::self_intersections(x, triangles),
+        finite: x.iter().all(|p| p.is_finite()),
+    }
 }
 
 /// Muscle vertices more than 1 mm out through the skin now, and the farthest (m).
