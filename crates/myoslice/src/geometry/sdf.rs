@@ -60,6 +60,10 @@ pub struct BoneSdf {
     vertex_normals: Vec<Vec3>,
 }
 
+/// Within this share of a cell of the surface a sample's normal is its closest feature's
+/// pseudo-normal, beyond it the direction from the closest point.
+const NORMAL_FROM_OFFSET: f32 = 0.25;
+
 impl BoneSdf {
     /// The field of a closed, outward surface, on nodes `cell` apart (m), exact within
     /// `band` (m) of it.
@@ -344,7 +348,9 @@ impl BoneSdf {
         } else {
             off.dot(pseudo) < 0.0
         };
-        let normal = if dist > 1e-7 {
+        // Very near the surface the offset's direction says little (next to an edge it
+        // may lie almost along the surface): the feature's pseudo-normal does.
+        let normal = if dist > NORMAL_FROM_OFFSET * self.cell {
             if inside { -off / dist } else { off / dist }
         } else {
             pseudo
