@@ -26,11 +26,7 @@ pub fn parse_nifti(raw: &[u8], path: &Path) -> Result<LabelVolume> {
         reason,
     };
     let bytes: std::borrow::Cow<'_, [u8]> = if raw.starts_with(&[0x1f, 0x8b]) {
-        let mut out = Vec::with_capacity(raw.len() * 8);
-        flate2::read::MultiGzDecoder::new(raw)
-            .read_to_end(&mut out)
-            .map_err(|e| err(format!("gzip stream is corrupt or truncated ({e})")))?;
-        out.into()
+        gunzip_bounded(raw).map_err(err)?.into()
     } else {
         raw.into()
     };
@@ -43,6 +39,44 @@ pub fn parse_nifti(raw: &[u8], path: &Path) -> Result<LabelVolume> {
     let h = Header::parse(&bytes).map_err(err)?;
     let volume = h.read_voxels(&bytes).map_err(err)?;
     Ok(volume)
+}
+
+/// Most bytes a label volume may take (header and voxels): 4 GiB, a 1024 × 1024 × 2048
+/// uint16 volume. Checked against what the header claims before anything that size is
+/// allocated or decompressed, so a corrupt header or a gzip bomb gives an error, not an
+/// abort.
+pub const MAX_VOLUME_BYTES: u64 = 4 << 30;
+
+/// Decompresses a gzip NIfTI no further than its header says the file reaches (header,
+/// then voxels): the header is read first, and a claim beyond [`MAX_VOLUME_BYTES`] is
+/// refused before the voxels are decompressed.
+fn gunzip_bounded(raw: &[u8]) -> std::result::Result<Vec<u8>, String> {
+    let corrupt = |e: std::io::Error| format!("gzip stream is corrupt or truncated ({e})");
+    let mut dec = flate2::read::MultiGzDecoder::new(raw);
+    let mut out = Vec::with_capacity(HEADER_LEN + 4);
+    (&mut dec)
+        .take(HEADER_LEN as u64 + 4)
+        .read_to_end(&mut out)
+        .map_err(corrupt)?;
+    if out.len() < HEADER_LEN {
+        // Too short for a header: the caller says so.
+        return Ok(out);
+    }
+    let claimed = Header::parse(&out)?.claimed_bytes();
+    if claimed > MAX_VOLUME_BYTES {
+        return Err(format!(
+            "the header claims {claimed} bytes of data, more than the {MAX_VOLUME_BYTES}-byte cap on a label volume"
+        ));
+    }
+    // What the header claims (the voxels' check names a shortfall), and not a byte more.
+    let rest = claimed.saturating_sub(out.len() as u64);
+    out.reserve(
+        usize::try_from(rest)
+            .unwrap_or(0)
+            .min(raw.len().saturating_mul(64)),
+    );
+    dec.take(rest).read_to_end(&mut out).map_err(corrupt)?;
+    Ok(out)
 }
 
 struct Header {
@@ -181,6 +215,16 @@ impl Header {
             slope,
             inter,
         })
+    }
+
+    /// Bytes the header says the file holds: the voxel offset and the voxels, at two
+    /// bytes a voxel for any type but uint8 (an unsupported type is refused later).
+    fn claimed_bytes(&self) -> u64 {
+        let per = if self.datatype == 2 { 1 } else { 2 };
+        self.dims
+            .iter()
+            .fold(per, |a: u64, &d| a.saturating_mul(d as u64))
+            .saturating_add(self.vox_offset as u64)
     }
 
     fn read_voxels(&self, b: &[u8]) -> std::result::Result<LabelVolume, String> {
