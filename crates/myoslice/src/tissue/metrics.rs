@@ -32,8 +32,9 @@ pub struct TissueMetrics {
     /// VTK's test of a valid hexahedron; an element can fold at a corner and keep a
     /// positive volume). Every element is tested, whichever were measured.
     pub inverted: usize,
-    /// Elements of zero or negative volume (turned inside out as a whole; each is also
-    /// counted in [`Self::inverted`]).
+    /// Measured elements of zero or negative volume (turned inside out as a whole; each
+    /// is also counted in [`Self::inverted`]). After an update only the elements it
+    /// relaxed are measured; the others moved with a bone and keep their rest volume.
     pub negative_volume: usize,
     /// Fat vertices the validity guard moved off the relaxed shape toward the knee fold
     /// in the last update (0: the elastic relaxation stood everywhere).
