@@ -10,6 +10,7 @@ use rayon::prelude::*;
 
 use super::distance_grid::DistanceGrid;
 use crate::body::BodyId;
+use crate::geometry::{Feature, closest_point};
 
 /// Most triangles a walk visits before it settles for the best seen.
 const MAX_WALK: usize = 24;
@@ -47,15 +48,6 @@ pub(crate) struct Walk {
     pub(crate) inside: bool,
     /// Whether it stopped at a local minimum of the distance (else it ran out of steps).
     pub(crate) settled: bool,
-}
-
-/// Which part of a triangle a closest point lies on.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Feature {
-    Face,
-    /// Edge from corner k to corner k + 1.
-    Edge(usize),
-    Vertex(usize),
 }
 
 impl BoneMesh {
@@ -139,15 +131,18 @@ impl BoneMesh {
 
     fn closest_on(&self, t: u32, p: Vec3) -> (Vec3, Feature) {
         let [a, b, c] = self.triangles[t as usize].map(|i| self.vertices[i as usize]);
-        closest_on_triangle(p, a, b, c)
+        let (q, _, feature) = closest_point(p, a, b, c);
+        (q, feature)
     }
 
     /// The outward pseudo-normal at `feature` of triangle `t`.
     fn pseudo_normal(&self, t: u32, feature: Feature) -> Vec3 {
         match feature {
             Feature::Face => self.normals[t as usize],
-            Feature::Edge(k) => self.edge_normals[t as usize][k],
-            Feature::Vertex(k) => self.vertex_normals[self.triangles[t as usize][k] as usize],
+            Feature::Edge(k) => self.edge_normals[t as usize][usize::from(k)],
+            Feature::Vertex(k) => {
+                self.vertex_normals[self.triangles[t as usize][usize::from(k)] as usize]
+            }
         }
     }
 
@@ -174,7 +169,7 @@ impl BoneMesh {
             // walk over edges alone can stall at a corner shared by many triangles).
             let corner = match best.1 {
                 Feature::Vertex(k) => {
-                    let v = self.triangles[cur as usize][k] as usize;
+                    let v = self.triangles[cur as usize][usize::from(k)] as usize;
                     &self.fan[self.fan_start[v] as usize..self.fan_start[v + 1] as usize]
                 }
                 _ => &[],
@@ -242,43 +237,6 @@ impl BoneMesh {
             None => w,
         }
     }
-}
-
-/// Closest point of triangle `abc` to `p` and the feature it lies on (Ericson, Real-Time
-/// Collision Detection 5.1.5).
-fn closest_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> (Vec3, Feature) {
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return (a, Feature::Vertex(0));
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return (b, Feature::Vertex(1));
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return (a + ab * (d1 / (d1 - d3)), Feature::Edge(0));
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return (c, Feature::Vertex(2));
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return (a + ac * (d2 / (d2 - d6)), Feature::Edge(2));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return (
-            b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))),
-            Feature::Edge(1),
-        );
-    }
-    let denom = 1.0 / (va + vb + vc);
-    (a + ab * (vb * denom) + ac * (vc * denom), Feature::Face)
 }
 
 /// The fat vertices that slide on bone, with their bone, rest distance and the triangle
@@ -402,7 +360,7 @@ mod tests {
     #[test]
     fn the_closest_point_of_a_triangle_is_found_in_each_region() {
         let (a, b, c) = (Vec3::ZERO, Vec3::X, Vec3::Y);
-        let near = |p: Vec3| closest_on_triangle(p, a, b, c).0;
+        let near = |p: Vec3| closest_point(p, a, b, c).0;
         assert!(near(Vec3::new(0.2, 0.2, 1.0)).distance(Vec3::new(0.2, 0.2, 0.0)) < 1e-6);
         assert_eq!(near(Vec3::new(-1.0, -1.0, 0.3)), a);
         assert_eq!(near(Vec3::new(2.0, -0.5, 0.0)), b);

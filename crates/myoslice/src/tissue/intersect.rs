@@ -1,8 +1,10 @@
 //! Exact(-enough) self-intersection test of a triangle surface: does any triangle cross
 //! another one it shares no vertex with?
 
-use glam::{DVec3, UVec3, Vec3, Vec3A};
+use glam::{UVec3, Vec3, Vec3A};
 use rayon::prelude::*;
+
+use crate::geometry::triangles_cross;
 
 /// Number of pairs of triangles (sharing no vertex) whose interiors cross.
 pub fn self_intersections(vertices: &[Vec3], triangles: &[[u32; 3]]) -> usize {
@@ -335,46 +337,6 @@ fn clearly_one_side(a: &[Vec3; 3], b: &[Vec3; 3]) -> bool {
     let margin = 1e-4 * scale * reach.sqrt();
     (d[0] > margin && d[1] > margin && d[2] > margin)
         || (d[0] < -margin && d[1] < -margin && d[2] < -margin)
-}
-
-fn segment_hits_triangle(p: DVec3, q: DVec3, t: &[DVec3; 3]) -> bool {
-    let d = q - p;
-    let e1 = t[1] - t[0];
-    let e2 = t[2] - t[0];
-    let h = d.cross(e2);
-    let a = e1.dot(h);
-    if a.abs() < 1e-18 {
-        return false;
-    }
-    let f = 1.0 / a;
-    let s = p - t[0];
-    let u = f * s.dot(h);
-    if !(0.0..=1.0).contains(&u) {
-        return false;
-    }
-    let qv = s.cross(e1);
-    let v = f * d.dot(qv);
-    if v < 0.0 || u + v > 1.0 {
-        return false;
-    }
-    let w = f * e2.dot(qv);
-    (0.0..=1.0).contains(&w)
-}
-
-/// Whether all corners of `a` lie strictly on one side of the plane of `b`.
-fn one_side_of(a: &[DVec3; 3], b: &[DVec3; 3]) -> bool {
-    let n = (b[1] - b[0]).cross(b[2] - b[0]);
-    let d = a.map(|p| n.dot(p - b[0]));
-    (d[0] > 0.0 && d[1] > 0.0 && d[2] > 0.0) || (d[0] < 0.0 && d[1] < 0.0 && d[2] < 0.0)
-}
-
-fn triangles_cross(a: &[DVec3; 3], b: &[DVec3; 3]) -> bool {
-    // Most neighbours whose boxes overlap are told apart by a plane test alone.
-    if one_side_of(a, b) || one_side_of(b, a) {
-        return false;
-    }
-    (0..3).any(|i| segment_hits_triangle(a[i], a[(i + 1) % 3], b))
-        || (0..3).any(|i| segment_hits_triangle(b[i], b[(i + 1) % 3], a))
 }
 
 #[cfg(test)]
