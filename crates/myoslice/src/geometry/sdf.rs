@@ -103,9 +103,15 @@ impl BoneSdf {
         [self.dims.x, self.dims.y, self.dims.z].map(|d| d as usize)
     }
 
-    /// How far from the surface (m) distances are exact.
+    /// How far from the surface (m) the field's nodes hold exact distances.
     pub fn band(&self) -> f32 {
         self.band
+    }
+
+    /// How far from the surface (m) a [`Self::sample`] is exact (from the nearest
+    /// triangles); beyond, it is interpolated between nodes.
+    pub fn exact_within(&self) -> f32 {
+        self.band - 2.0 * self.cell
     }
 
     #[inline]
@@ -286,7 +292,7 @@ impl BoneSdf {
         let y0 = lerp(x00, x10, fy);
         let y1 = lerp(x01, x11, fy);
         let trilinear = lerp(y0, y1, fz);
-        if trilinear.abs() > self.band - 2.0 * self.cell {
+        if trilinear.abs() > self.exact_within() {
             let gx = lerp(
                 lerp(d[1] - d[0], d[3] - d[2], fy),
                 lerp(d[5] - d[4], d[7] - d[6], fy),

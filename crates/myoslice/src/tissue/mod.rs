@@ -49,6 +49,7 @@ pub use tissue_config::TissueConfig;
 
 use crate::body::{BodyId, KneeAxis, body_of_bone};
 use crate::error::Result;
+use crate::geometry::BoneSdf;
 use crate::lattice::{InnerContact, Lattice};
 use crate::muscle::{BodyFrames, MuscleUnit};
 pub use bone_overlap::BoneOverlap;
@@ -72,6 +73,13 @@ const GUARD_RADIUS: f32 = 0.25;
 /// earlier corrections kept most elements relaxing long after they had stopped moving
 /// (docs/speed-history.md, 2026-12-04 night).
 const RIGID_TOLERANCE_M2: f32 = 1e-8;
+
+/// Node spacing (m) of the bones' distance fields: exact within
+/// [`SDF_BAND_M`] − 2 cells of the surface, interpolated beyond.
+const SDF_CELL_M: f32 = 0.002;
+
+/// How far (m) from each bone's surface its distance field holds exact distances.
+const SDF_BAND_M: f32 = 0.006;
 
 /// Bone surfaces for tissue queries: body and mesh (rest frame) of each lattice bone.
 pub type BoneSurfaces = Arc<Vec<(BodyId, TriMesh)>>;
@@ -101,6 +109,10 @@ struct TissueStatic {
     bone_meshes: Vec<BoneMesh>,
     /// The same surfaces as parry meshes (with a tree, for the rare global query).
     bones: BoneSurfaces,
+    /// Signed distance field of each bone, lattice bone order (rest frame).
+    bone_sdfs: Vec<BoneSdf>,
+    /// Fat vertices that slide on bone.
+    bone_slide: BoneSlide,
     /// Outer (skin) face of each outer-layer element and its rest area (m²).
     outer_faces: Vec<(u32, [u32; 4], f64)>,
     /// The skin closed at both ends (for [`Tissue::muscles_outside_skin`]).
@@ -153,8 +165,6 @@ pub struct Tissue {
     /// The fat solver.
     pub fat: FatSolver,
     fixed: Arc<TissueStatic>,
-    /// Fat vertices that slide on bone, with the triangle each last touched.
-    bone_slide: BoneSlide,
     /// Fat vertices the fold can bring near a bone, kept out of it.
     fat_keep_out: FatKeepOut,
     /// Motion of the last update beyond the skinned guess (for momentum).
@@ -186,6 +196,10 @@ impl Tissue {
     ) -> Result<Self> {
         config.validate()?;
         let bone_meshes: Vec<BoneMesh> = bones.iter().map(|(b, m)| BoneMesh::new(*b, m)).collect();
+        let bone_sdfs: Vec<BoneSdf> = bones
+            .par_iter()
+            .map(|(_, m)| BoneSdf::new(m.vertices(), m.indices(), SDF_CELL_M, SDF_BAND_M))
+            .collect();
         let rest_contact = KneeFold::new(&knee, 0.0).contact(0.0);
         let shapes: Vec<MuscleShape> = muscles
             .par_iter()
@@ -272,8 +286,10 @@ impl Tissue {
             posterior,
             guard_triangles,
             zone,
+            bone_slide: BoneSlide::new(&on_bone, &fat.vertices, &bone_sdfs, &bones),
             bone_meshes,
             bones: Arc::clone(&bones),
+            bone_sdfs,
             outer_faces,
             skin: ClosedSkin::new(fat),
             bones_crossed: OnceLock::new(),
@@ -283,7 +299,6 @@ impl Tissue {
             muscles: shapes,
             drift: vec![Vec3::ZERO; nv],
             fat: solver,
-            bone_slide: BoneSlide::new(&on_bone, &fat.vertices, &bones),
             fat_keep_out,
             fixed: Arc::new(fixed),
             scratch: Scratch::default(),
@@ -492,10 +507,10 @@ impl Tissue {
             BodyId::Thigh => frames.thigh,
             BodyId::Shank => frames.shank,
         };
-        self.bone_slide.apply(
+        fixed.bone_slide.apply(
             &mut self.fat.x,
             &self.fat.free,
-            &fixed.bone_meshes,
+            &fixed.bone_sdfs,
             &fixed.bones,
             pose,
         );

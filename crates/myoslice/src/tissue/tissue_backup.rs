@@ -4,7 +4,6 @@ use glam::{Quat, Vec3};
 
 use super::Tissue;
 use super::bone_keep_out::KeepOutMemory;
-use super::bone_slide::BoneSlide;
 use super::fat_keep_out::PairMemory;
 use super::metrics::LazyMetrics;
 
@@ -18,7 +17,6 @@ pub(crate) struct TissueBackup {
     drift: Vec<Vec3>,
     theta: f32,
     metrics: LazyMetrics,
-    bone_slide: BoneSlide,
     fat_keep_out: Vec<PairMemory>,
     muscles: Vec<(Vec<Vec3>, f64, KeepOutMemory)>,
 }
@@ -36,7 +34,6 @@ impl Tissue {
             drift: self.drift.clone(),
             theta: self.theta,
             metrics: self.metrics.clone(),
-            bone_slide: self.bone_slide.clone(),
             fat_keep_out: self.fat_keep_out.memory(),
             muscles: self
                 .muscles
@@ -51,7 +48,6 @@ impl Tissue {
         (self.fat.x, self.fat.rot) = (b.fat_x, b.fat_rot);
         (self.fat.free, self.fat.active) = (b.fat_free, b.fat_active);
         (self.drift, self.theta, self.metrics) = (b.drift, b.theta, b.metrics);
-        self.bone_slide = b.bone_slide;
         self.fat_keep_out.recall(b.fat_keep_out);
         // Shapes placed ahead for an update that will not come now.
         self.placed = None;
