@@ -207,12 +207,12 @@ fn tissue_never_breaks_on(lattice: Lattice, speed: f64, folded: (usize, usize)) 
 
 #[test]
 fn fat_never_inverts_nor_self_intersects_through_a_deep_flexion() {
-    tissue_never_breaks_on(common::phantom_lattice().clone(), 1.0, (725, 20));
+    tissue_never_breaks_on(common::phantom_lattice().clone(), 1.0, (610, 10));
 }
 
 #[test]
 fn fat_never_inverts_nor_self_intersects_at_three_times_the_speed() {
-    tissue_never_breaks_on(common::phantom_lattice().clone(), 3.0, (725, 70));
+    tissue_never_breaks_on(common::phantom_lattice().clone(), 3.0, (610, 50));
 }
 
 /// The README's table of tissue rates offers a third of the default rate as a trade of
@@ -222,7 +222,7 @@ fn fat_never_inverts_nor_self_intersects_at_a_third_of_the_tissue_rate() {
     let mut cfg = SimulationConfig::default();
     cfg.tissue.rate_hz /= 3.0;
     let sim = Simulation::phantom(cfg).unwrap();
-    let max = tissue_never_breaks(sim, 1.0, (550, 15));
+    let max = tissue_never_breaks(sim, 1.0, (430, 10));
     // Updates 0.1 s apart fall at most at 123° of the flexion's 134°.
     assert!(
         max > 120.0,
@@ -235,7 +235,7 @@ fn visible_human_fat_never_inverts_nor_self_intersects_through_a_deep_flexion() 
     let Some(lattice) = common::vh_lattice() else {
         return;
     };
-    tissue_never_breaks_on(lattice.clone(), 1.0, (725, 35));
+    tissue_never_breaks_on(lattice.clone(), 1.0, (585, 15));
 }
 
 #[test]
@@ -243,7 +243,7 @@ fn visible_human_fat_never_inverts_nor_self_intersects_at_three_times_the_speed(
     let Some(lattice) = common::vh_lattice() else {
         return;
     };
-    tissue_never_breaks_on(lattice.clone(), 3.0, (725, 80));
+    tissue_never_breaks_on(lattice.clone(), 3.0, (585, 50));
 }
 
 /// After a deep flexion and back, with every muscle relaxed and the knee held straight
@@ -294,7 +294,7 @@ fn fat_after_flexion_and_rest(mut sim: Simulation) -> (f32, f32, f32, usize) {
 
 /// The bounds of [`fat_after_flexion_and_rest`]: within 2 mm of rest on bone, elsewhere
 /// no further than the muscles it rides (which keep some of their shape), and no more
-/// than 4 elements still folded (2 measured on either leg).
+/// than 4 elements still folded (4 and 3 measured).
 fn fat_comes_back_to_rest(sim: Simulation) {
     let (anywhere, on_bone, muscles, folded) = fat_after_flexion_and_rest(sim);
     assert!(
@@ -637,7 +637,7 @@ fn muscles_reach_out_no_further_than_recorded(mut sim: Simulation) {
     );
     eprintln!("{summary}");
     assert!(
-        rising_45 < 0.006 && most < 1_600 && below_70 < 600 && farthest < 0.020,
+        rising_45 < 0.006 && most < 1_000 && below_70 < 600 && farthest < 0.020,
         "{summary}"
     );
 }

@@ -60,6 +60,13 @@ use guard::Guard;
 /// Share of a muscle surface's sliding (along the fat layer) that drags the fat over it.
 const FASCIA_DRAG: f32 = 0.2;
 
+/// Share of the way to its target across the fat layer an inner vertex facing a muscle
+/// is pulled each iteration, and along the muscle (see [`Tissue::apply_muscles`]).
+/// Pulled along as hard as across, the fat was held where it folded and muscles came
+/// out through it; much weaker, more muscle came out (docs/tissue-history.md).
+const PULL_ACROSS: f32 = 0.7;
+const PULL_ALONG: f32 = 0.15;
+
 /// Extra distance (m) from the contact plane per fat layer below the skin.
 const LAYER_GAP: f32 = 0.001;
 
@@ -141,8 +148,9 @@ struct Scratch {
     /// The first guess of the update.
     guess: Vec<Vec3>,
     moving: Vec<bool>,
-    /// Where each inner vertex facing a muscle is pulled this update.
-    muscle_targets: Vec<(u32, Vec3)>,
+    /// Where each inner vertex facing a muscle is pulled this update, and the direction
+    /// across its fat layer.
+    muscle_targets: Vec<(u32, Vec3, Vec3)>,
     /// How far from the contact plane each skin vertex behind the knee may lie this
     /// update before it is pulled, and the share of the excess a pass removes
     /// ([`crease::skin_limits`]).
@@ -422,31 +430,46 @@ impl Tissue {
         // Where each inner vertex facing a muscle goes: with its reference muscle vertex,
         // keeping its rest offset from it turned as the tissue about it turns (the
         // paper's moving vector alone would shear thin fat at large angles).
+        let (muscles, fat_rest, layers) = (&self.muscles, &self.fat.rest, self.layers);
         sc.muscle_targets.clear();
-        for (v, r) in fixed.muscle_ref.iter().enumerate() {
-            let Some((m, mv)) = *r else { continue };
-            let shape = &self.muscles[m as usize];
-            let turn = tq * Quat::from_axis_angle(fold.axis, theta * weights[v]);
-            let offset = self.fat.rest[v] - shape.rest[mv as usize];
-            let follow = shape.current[mv as usize] + turn * offset;
-            // Across the layer the fat follows the muscle fully (a bulge pushes the skin
-            // out); along it the muscle glides under its fascia and drags the fat only
-            // partly (following its sliding fully shears the elements inside out).
-            let (base, outer) = (safe[v], safe[v + self.layers]);
-            let n = (outer - base).normalize_or_zero();
-            let d = follow - base;
-            let across = n * d.dot(n);
-            sc.muscle_targets
-                .push((v as u32, base + across + (d - across) * FASCIA_DRAG));
-        }
+        sc.muscle_targets
+            .par_extend(
+                fixed
+                    .muscle_ref
+                    .par_iter()
+                    .enumerate()
+                    .filter_map(|(v, r)| {
+                        let (m, mv) = (*r)?;
+                        let shape = &muscles[m as usize];
+                        let turn = tq * Quat::from_axis_angle(fold.axis, theta * weights[v]);
+                        let offset = fat_rest[v] - shape.rest[mv as usize];
+                        let follow = shape.current[mv as usize] + turn * offset;
+                        // Across the layer the fat follows the muscle fully (a bulge pushes the
+                        // skin out); along it the muscle glides under its fascia and drags the fat
+                        // only partly (following its sliding fully shears the elements inside out).
+                        let (base, outer) = (safe[v], safe[v + layers]);
+                        let n = (outer - base).normalize_or_zero();
+                        let d = follow - base;
+                        let across = n * d.dot(n);
+                        let along = (d - across) * FASCIA_DRAG;
+                        // Across it, the fat keeps its rest offset from the muscle's surface where
+                        // the fat now lies over it, not from the vertex it lay over at rest: a
+                        // muscle that slides far under the fat (a gastrocnemius as the knee bends)
+                        // would otherwise carry the fat over its own tapering ends, and through
+                        // neighbouring tissue.
+                        let across = shape
+                            .surface_under(mv, base + along)
+                            .map_or(across, |q| n * (q + turn * offset - base).dot(n));
+                        Some((v as u32, base + across + along, n))
+                    }),
+            );
         // First guess, from the fold (so nothing accumulates): each radial column of
         // vertices moves with its inner vertex where that follows a muscle (across the
         // layer as a whole, along it the skin by half as much); part of the last
         // update's correction is carried over (inertia with damping).
         let momentum = self.config.momentum as f32;
-        let layers = self.layers;
         sc.guess.clone_from(safe);
-        for &(inner, target) in &sc.muscle_targets {
+        for &(inner, target, _) in &sc.muscle_targets {
             // Inner vertices are layer 0 of their column (see `FatLattice::vertex_index`).
             let inner = inner as usize;
             let delta = target - sc.guess[inner];
@@ -533,13 +556,16 @@ impl Tissue {
     }
 
     /// Pulls inner vertices facing a muscle toward their targets (the paper's rule, see
-    /// [`FASCIA_DRAG`]), strongly but not rigidly, so that millimetre noise of the muscle
-    /// surface cannot fold the thin fat elements; shape matching shares the rest.
-    fn apply_muscles(&mut self, targets: &[(u32, Vec3)]) {
-        const PULL: f32 = 0.7;
-        for &(v, target) in targets {
+    /// [`FASCIA_DRAG`]): across the layer (along `n`, the third field) strongly but not
+    /// rigidly, so that millimetre noise of the muscle surface cannot fold the thin fat
+    /// elements; along the muscle weakly, so that the fat glides on its fascia where the
+    /// elements about it pull. Shape matching shares the rest.
+    fn apply_muscles(&mut self, targets: &[(u32, Vec3, Vec3)]) {
+        for &(v, target, n) in targets {
             let cur = self.fat.x[v as usize];
-            self.fat.x[v as usize] = cur + (target - cur) * PULL;
+            let d = target - cur;
+            let across = n * d.dot(n);
+            self.fat.x[v as usize] = cur + across * PULL_ACROSS + (d - across) * PULL_ALONG;
         }
     }
 

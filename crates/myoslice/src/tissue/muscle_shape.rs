@@ -16,6 +16,10 @@ use crate::muscle::MuscleChain;
 /// were shifted far out of bone (plantaris by the condyle) needed more than five.
 const VOLUME_PASSES: usize = 12;
 
+/// How many rings either way [`MuscleShape::surface_under`] looks, within the ring's
+/// tube (5 mm slices: 6 cm).
+const MERIDIAN_RINGS: usize = 12;
+
 /// Where a ring rides on the chain and how its vertices sit around it.
 #[derive(Debug, Clone)]
 pub struct MuscleShape {
@@ -27,6 +31,12 @@ pub struct MuscleShape {
     ring_param: Vec<(u32, f32)>,
     /// Ring index of each vertex.
     ring_of: Vec<u32>,
+    /// First surface vertex of each ring; a ring's vertices are consecutive.
+    ring_first: Vec<u32>,
+    /// Surface vertices per ring.
+    ring_len: u32,
+    /// First and last ring of each ring's tube (a muscle may be several tubes).
+    tube_of_ring: Vec<(u32, u32)>,
     /// Axial offset and perpendicular offset of each vertex in its segment's rest frame.
     axial: Vec<f32>,
     perp: Vec<Vec3>,
@@ -42,6 +52,21 @@ pub struct MuscleShape {
     pub triangles: Vec<[u32; 3]>,
     /// The rings' shifts out of bone and back to their side of the contact plane.
     pub(crate) keep: BoneKeepOut,
+}
+
+/// First and last ring of the tube each ring of `mesh` belongs to (a ring in no tube is
+/// a tube of its own).
+fn tube_of_ring(mesh: &crate::lattice::TubeMesh) -> Vec<(u32, u32)> {
+    let mut out: Vec<(u32, u32)> = (0..mesh.rings.len() as u32).map(|r| (r, r)).collect();
+    for t in &mesh.tubes {
+        if t.is_empty() || t.end as usize > out.len() {
+            continue;
+        }
+        for r in t.clone() {
+            out[r as usize] = (t.start, t.end - 1);
+        }
+    }
+    out
 }
 
 /// Closest point to `q` on the segments of polyline `p` that `allowed` admits.
@@ -103,6 +128,9 @@ impl MuscleShape {
             belly,
             ring_param,
             ring_of,
+            ring_first: mesh.rings.iter().map(|r| r.first).collect(),
+            ring_len: n,
+            tube_of_ring: tube_of_ring(mesh),
             axial,
             perp,
             current: mesh.vertices.clone(),
@@ -112,6 +140,36 @@ impl MuscleShape {
             triangles: mesh.triangles.clone(),
             keep: BoneKeepOut::default(),
         }
+    }
+
+    /// The point nearest `p` on the line of surface vertices through `v` from ring to
+    /// ring (a meridian), within [`MERIDIAN_RINGS`] rings of `v`'s: the muscle's surface
+    /// under `p` when the muscle has slid under it along its length. None when `v` is no
+    /// ring's surface vertex. (A walk from `v`'s ring toward `p` stops at the first
+    /// local minimum, on a bulge's far side: it left more muscle out through the skin.)
+    pub(crate) fn surface_under(&self, v: u32, p: Vec3) -> Option<Vec3> {
+        let r0 = *self.ring_of.get(v as usize)? as usize;
+        let slot = v
+            .checked_sub(self.ring_first[r0])
+            .filter(|s| *s < self.ring_len)?;
+        let at = |r: usize| self.current[(self.ring_first[r] + slot) as usize];
+        let (first, last) = self.tube_of_ring[r0];
+        let lo = r0.saturating_sub(MERIDIAN_RINGS).max(first as usize);
+        let hi = (r0 + MERIDIAN_RINGS).min(last as usize);
+        let mut best = (at(r0), at(r0).distance_squared(p));
+        let mut a = at(lo);
+        for r in lo..hi {
+            let b = at(r + 1);
+            let ab = b - a;
+            let t = ((p - a).dot(ab) / ab.length_squared().max(1e-12)).clamp(0.0, 1.0);
+            let q = a + ab * t;
+            let d = q.distance_squared(p);
+            if d < best.1 {
+                best = (q, d);
+            }
+            a = b;
+        }
+        Some(best.0)
     }
 
     /// Watches the vertices near `bones` at rest (more of them near the knee, the point
@@ -355,4 +413,67 @@ fn volume_about(vertices: &[Vec3], triangles: &[[u32; 3]], origin: Vec3) -> f64 
         v += f64::from(part);
     }
     (v / 6.0).abs()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two tubes of square rings (4 vertices, 1 cm across), 5 mm apart along z: rings
+    /// 0–5 about x = 0, rings 6–8 about x = 5 cm. Vertex `4 r + k` is corner k of ring r.
+    fn two_tubes() -> MuscleShape {
+        let corner = [Vec3::X, Vec3::Y, -Vec3::X, -Vec3::Y];
+        let mut current = Vec::new();
+        let mut ring_of = Vec::new();
+        for r in 0..9u32 {
+            let centre = if r < 6 {
+                Vec3::new(0.0, 0.0, 0.005 * r as f32)
+            } else {
+                Vec3::new(0.05, 0.0, 0.005 * (r - 6) as f32)
+            };
+            current.extend(corner.iter().map(|c| centre + *c * 0.005));
+            ring_of.extend([r; 4]);
+        }
+        MuscleShape {
+            rest_chain: Vec::new(),
+            belly: Vec::new(),
+            ring_param: Vec::new(),
+            ring_of,
+            ring_first: (0..9).map(|r| 4 * r).collect(),
+            ring_len: 4,
+            tube_of_ring: (0..9)
+                .map(|r| if r < 6 { (0, 5) } else { (6, 8) })
+                .collect(),
+            axial: Vec::new(),
+            perp: Vec::new(),
+            rest: current.clone(),
+            current,
+            rest_volume: 0.0,
+            volume_now: 0.0,
+            triangles: Vec::new(),
+            keep: BoneKeepOut::default(),
+        }
+    }
+
+    #[test]
+    fn the_surface_under_a_point_is_found_along_its_vertex_meridian_within_its_tube() {
+        let s = two_tubes();
+        // Corner 0 of ring 1 (x = 5 mm, z = 5 mm); a point 3 mm out from that meridian at
+        // z = 17 mm lies over the segment between rings 3 and 4.
+        let q = s.surface_under(4, Vec3::new(0.008, 0.0, 0.017)).unwrap();
+        assert!(q.distance(Vec3::new(0.005, 0.0, 0.017)) < 1e-6, "{q}");
+        // Past the tube's end the meridian's last vertex.
+        let q = s.surface_under(4, Vec3::new(0.008, 0.0, 0.1)).unwrap();
+        assert!(q.distance(Vec3::new(0.005, 0.0, 0.025)) < 1e-6, "{q}");
+        // Never on another tube, however near it lies.
+        let q = s.surface_under(4, Vec3::new(0.056, 0.0, 0.005)).unwrap();
+        assert!(q.x < 0.01, "{q}");
+        // The moved surface, not the rest one.
+        let mut moved = s.clone();
+        moved.current.iter_mut().for_each(|p| p.x += 0.002);
+        let q = moved.surface_under(4, Vec3::new(0.01, 0.0, 0.01)).unwrap();
+        assert!(q.distance(Vec3::new(0.007, 0.0, 0.01)) < 1e-6, "{q}");
+        // No such vertex.
+        assert!(s.surface_under(99, Vec3::ZERO).is_none());
+    }
 }
