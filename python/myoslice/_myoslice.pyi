@@ -40,6 +40,12 @@ class _StepTimers(TypedDict):
     realtime_factor: float | None
     tissue_phases_s: _TissuePhases
 
+class _GuardTally(TypedDict):
+    """What :attr:`Simulation.guard_tally` returns."""
+
+    updates: int
+    vertices: int
+
 class _MusclesInBone(TypedDict):
     """What :meth:`Simulation.muscles_in_bone` returns, one entry per muscle."""
 
@@ -243,6 +249,17 @@ class Simulation:
     def muscle_volume_ratio(self) -> npt.NDArray[np.float32]:
         """Volume over rest volume of each muscle, float32 ``(n_muscles,)``; shape
         ``(0,)`` without tissue."""
+
+    @property
+    def folded_elements(self) -> int:
+        """Fat elements with a folded corner now (a corner Jacobian at or below zero,
+        ParaView's test of a valid hexahedron); 0 without tissue."""
+
+    @property
+    def guard_tally(self) -> _GuardTally:
+        """How often the tissue's validity guard stepped in since the build:
+        ``updates`` (tissue updates it moved fat in) and ``vertices`` (fat vertices it
+        moved, summed); zeros without tissue. Part of a checkpoint."""
 
     def muscles_in_bone(self) -> _MusclesInBone:
         """How far each muscle's surface reaches into bone now, in :attr:`muscle_names`

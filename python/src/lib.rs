@@ -447,6 +447,29 @@ impl PySimulation {
         metric_array(py, &self.sim, |m| &m.muscle_volume_ratio)
     }
 
+    /// Fat elements with a folded corner now (a corner Jacobian at or below zero,
+    /// ParaView's test of a valid hexahedron); 0 without tissue.
+    #[getter]
+    fn folded_elements(&self) -> usize {
+        self.sim.tissue_metrics().map_or(0, |m| m.inverted)
+    }
+
+    /// How often the tissue's validity guard stepped in since the build: a dict of
+    /// `updates` (tissue updates it moved fat in) and `vertices` (fat vertices it moved,
+    /// summed); zeros without tissue. Part of a checkpoint.
+    #[getter]
+    fn guard_tally<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let t = self
+            .sim
+            .tissue()
+            .map(|t| t.guard_tally())
+            .unwrap_or_default();
+        let d = PyDict::new(py);
+        d.set_item("updates", t.updates)?;
+        d.set_item("vertices", t.vertices)?;
+        Ok(d)
+    }
+
     /// How far each muscle's surface reaches into bone now: a dict of per-muscle arrays
     /// `vertices_over_1mm` (int64) and `deepest_m` (float32), empty without tissue.
     fn muscles_in_bone<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {

@@ -478,6 +478,20 @@ def test_tissue_elements_do_not_invert(tissue: Simulation) -> None:
     )
 
 
+def test_folds_and_the_guard_tally_are_reported(tissue: Simulation, rigid: Simulation) -> None:
+    assert tissue.folded_elements == 0 and tissue.guard_tally == {"updates": 0, "vertices": 0}
+    checkpoint = tissue.state()
+    flex(tissue, 0.3)
+    folded, tally = tissue.folded_elements, tissue.guard_tally
+    assert isinstance(folded, int) and 0 <= folded < tissue.n_fat_elements
+    assert tally["updates"] <= tally["vertices"] and (tally["updates"] == 0) == (tally["vertices"] == 0)
+    # The tally goes with the checkpoint.
+    tissue.set_state(checkpoint)
+    assert tissue.guard_tally == {"updates": 0, "vertices": 0}
+    flex(rigid, 0.05)
+    assert rigid.folded_elements == 0 and rigid.guard_tally == {"updates": 0, "vertices": 0}
+
+
 def test_tissue_rate_and_iterations_are_applied(tissue: Simulation) -> None:
     # Fewer shape-matching iterations leave the fat less relaxed: another skin.
     fewer = Simulation.phantom(tissue_iterations=1)

@@ -128,6 +128,11 @@ def test_each_example_scenario_runs_and_its_outputs_parse(scenario: Path, tmp_pa
     folded = [folded_hexahedra(tmp_path / f) for f in files]
     assert summary["inverted_elements"] >= max(folded)
     assert summary["final_inverted_elements"] == folded[-1]
+    # The guard's interventions: counted over the run, vertices only where updates were.
+    guard = summary["guard"]
+    assert isinstance(guard["updates"], int) and isinstance(guard["vertices"], int)
+    assert guard["updates"] <= guard["vertices"]
+    assert (guard["updates"] == 0) == (guard["vertices"] == 0)
 
 
 def test_the_papers_experiment_flexes_the_knee_with_finite_tissue(tmp_path: Path) -> None:

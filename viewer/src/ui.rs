@@ -299,6 +299,15 @@ impl UiState {
                 ));
                 ui.end_row();
             }
+            if let Some(t) = sim.tissue() {
+                let g = t.guard_tally();
+                ui.label("guard");
+                ui.label(format!(
+                    "stepped in at {} updates ({} vertices)",
+                    g.updates, g.vertices
+                ));
+                ui.end_row();
+            }
         });
     }
 

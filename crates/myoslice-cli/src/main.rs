@@ -316,6 +316,13 @@ fn run_scenario(a: &RunArgs) -> Result<()> {
             summary.frames,
             a.out.display()
         );
+        println!(
+            "fat elements folded (ParaView's test): at most {}, {} at the end; the validity guard stepped in at {} tissue updates ({} vertices)",
+            summary.inverted_elements,
+            summary.final_inverted_elements,
+            summary.guard.updates,
+            summary.guard.vertices
+        );
     }
     Ok(())
 }

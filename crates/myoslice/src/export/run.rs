@@ -14,6 +14,7 @@ use super::vtu::{write_atomic, write_pvd};
 use crate::body::{BodyId, body_of_bone};
 use crate::error::{Error, Result};
 use crate::simulation::Simulation;
+use crate::tissue::GuardTally;
 
 /// What to write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -52,6 +53,9 @@ pub struct RunSummary {
     pub inverted_elements: usize,
     /// Fat elements with a folded corner in the last frame (whether the fat came back).
     pub final_inverted_elements: usize,
+    /// How often the validity guard, the tissue's last resort, moved fat back toward
+    /// the knee fold over the run (zeros without tissue).
+    pub guard: GuardTally,
     /// Wall time of the run (s).
     pub wall_time_s: f64,
     /// Simulated seconds per wall second.
@@ -118,6 +122,7 @@ impl RunWriter {
                 muscle_volume_ratio_range: [1.0, 1.0],
                 inverted_elements: 0,
                 final_inverted_elements: 0,
+                guard: GuardTally::default(),
                 wall_time_s: 0.0,
                 realtime_factor: 0.0,
                 muscles_wall_time_s: 0.0,
@@ -222,6 +227,7 @@ impl RunWriter {
         };
         self.summary.muscles_wall_time_s = sim.timers().muscles_wall_s();
         self.summary.tissue_wall_time_s = sim.timers().tissue_wall_s;
+        self.summary.guard = sim.tissue().map(|t| t.guard_tally()).unwrap_or_default();
         if self.summary.knee_angle_range_deg[0] > self.summary.knee_angle_range_deg[1] {
             self.summary.knee_angle_range_deg = [0.0, 0.0];
         }

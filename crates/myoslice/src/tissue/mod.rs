@@ -11,6 +11,7 @@ mod fat_keep_out;
 mod fat_lanes;
 pub mod fat_solver;
 mod guard;
+mod guard_tally;
 mod incidence;
 pub mod intersect;
 pub mod knee_fold;
@@ -35,6 +36,7 @@ use parry3d::shape::TriMesh;
 use rayon::prelude::*;
 
 pub use fat_solver::FatSolver;
+pub use guard_tally::GuardTally;
 pub use knee_fold::{Contact, FoldZone, KneeFold};
 use metrics::LazyMetrics;
 pub use metrics::TissueMetrics;
@@ -183,6 +185,8 @@ pub struct Tissue {
     layers: usize,
     /// Metrics of the last update (see [`Self::metrics`]).
     metrics: LazyMetrics,
+    /// The guard's interventions so far.
+    guard_tally: GuardTally,
     /// Time accumulated since the last update (s).
     pub(crate) pending: f64,
     /// How long each phase of the last update took.
@@ -314,6 +318,7 @@ impl Tissue {
             theta: 0.0,
             layers: fat.layers,
             metrics: LazyMetrics::built(),
+            guard_tally: GuardTally::default(),
             pending: 0.0,
             last_phases: TissuePhases::default(),
             placed: None,
@@ -326,6 +331,11 @@ impl Tissue {
     /// between changes what they describe).
     pub fn metrics(&self) -> &TissueMetrics {
         self.metrics.of(self)
+    }
+
+    /// How often the validity guard stepped in since the tissue was built.
+    pub fn guard_tally(&self) -> GuardTally {
+        self.guard_tally
     }
 
     /// The options.

@@ -2,10 +2,10 @@
 
 use glam::{Quat, Vec3};
 
-use super::Tissue;
 use super::bone_keep_out::KeepOutMemory;
 use super::fat_keep_out::PairMemory;
 use super::metrics::LazyMetrics;
+use super::{GuardTally, Tissue};
 
 /// A tissue's changing state, to put back after a failed update or `step` call.
 #[derive(Debug)]
@@ -17,6 +17,7 @@ pub(crate) struct TissueBackup {
     drift: Vec<Vec3>,
     theta: f32,
     metrics: LazyMetrics,
+    guard_tally: GuardTally,
     fat_keep_out: Vec<PairMemory>,
     muscles: Vec<(Vec<Vec3>, f64, KeepOutMemory)>,
 }
@@ -34,6 +35,7 @@ impl Tissue {
             drift: self.drift.clone(),
             theta: self.theta,
             metrics: self.metrics.clone(),
+            guard_tally: self.guard_tally,
             fat_keep_out: self.fat_keep_out.memory(),
             muscles: self
                 .muscles
@@ -48,6 +50,7 @@ impl Tissue {
         (self.fat.x, self.fat.rot) = (b.fat_x, b.fat_rot);
         (self.fat.free, self.fat.active) = (b.fat_free, b.fat_active);
         (self.drift, self.theta, self.metrics) = (b.drift, b.theta, b.metrics);
+        self.guard_tally = b.guard_tally;
         self.fat_keep_out.recall(b.fat_keep_out);
         // Shapes placed ahead for an update that will not come now.
         self.placed = None;

@@ -83,6 +83,7 @@ impl Tissue {
         }
         self.scratch = sc;
         self.metrics = LazyMetrics::updated(guarded);
+        self.guard_tally.add(guarded);
         phases.guard_s = lap.lap();
         self.last_phases = phases;
     }
