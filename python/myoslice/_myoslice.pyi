@@ -111,6 +111,7 @@ class Simulation:
         volume: _StrPath,
         labels: _StrPath,
         *,
+        unmapped: str = "error",
         slice_step: int = 5,
         rays: int = 48,
         body_mass_kg: float = 60.0,
@@ -125,7 +126,10 @@ class Simulation:
         chain_tether: float | None = None,
         chain_tether_release_n: float | None = None,
     ) -> Simulation:
-        """A model from a NIfTI label volume and its label table (JSON or TOML)."""
+        """A model from a NIfTI label volume and its label table (JSON or TOML), or a
+        segmentation tool's label list (ITK-SNAP label description file, 3D Slicer colour
+        table) whose names are mapped onto known structures; ``unmapped`` (``"error"``,
+        ``"fat"`` or ``"ignore"``) says what to do with a name none is known by."""
 
     @staticmethod
     def from_scenario(path: _StrPath) -> Simulation:

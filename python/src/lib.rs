@@ -8,6 +8,7 @@ mod errors;
 use std::path::PathBuf;
 use std::sync::OnceLock;
 
+use myoslice::label_names::Unmapped;
 use myoslice::muscle::MuscleCatalogue;
 use myoslice::prelude::*;
 use myoslice::simulation::{Layer, SimulationState};
@@ -112,14 +113,17 @@ impl PySimulation {
         })
     }
 
-    /// A NIfTI label volume with its label table (JSON or TOML).
+    /// A NIfTI label volume with its label table (JSON or TOML), or a segmentation tool's
+    /// label list (ITK-SNAP, 3D Slicer), whose names are mapped onto known structures;
+    /// `unmapped` ("error", "fat" or "ignore") says what to do with a name none is known by.
     #[staticmethod]
-    #[pyo3(signature = (volume, labels, *, slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, tissue_iterations = None, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, chain_tether_release_n = None))]
+    #[pyo3(signature = (volume, labels, *, unmapped = "error", slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, tissue_iterations = None, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, chain_tether_release_n = None))]
     #[allow(clippy::too_many_arguments)]
     fn from_nifti(
         py: Python<'_>,
         volume: PathBuf,
         labels: PathBuf,
+        unmapped: &str,
         slice_step: usize,
         rays: usize,
         body_mass_kg: f64,
@@ -136,6 +140,19 @@ impl PySimulation {
     ) -> PyResult<Self> {
         check_path(py, &volume, "volume")?;
         check_path(py, &labels, "label table")?;
+        let unmapped = match unmapped {
+            "error" => Unmapped::Error,
+            "fat" => Unmapped::Fat,
+            "ignore" => Unmapped::Ignore,
+            other => {
+                return Err(myoslice::Error::InvalidValue {
+                    name: "unmapped".into(),
+                    value: format!("'{other}'"),
+                    expected: "\"error\", \"fat\" or \"ignore\"".into(),
+                })
+                .or_py(py);
+            }
+        };
         let c = ConfigArgs {
             body_mass_kg,
             height_m,
@@ -159,7 +176,12 @@ impl PySimulation {
             ..BuildOptions::default()
         };
         let sim = py
-            .detach(move || Simulation::from_nifti(volume, labels, &build, c))
+            .detach(move || {
+                let v = myoslice::io::read_nifti(&volume)?;
+                let t = LabelTable::from_path_with(&labels, unmapped)?;
+                let lattice = myoslice::Lattice::build(&v, &t, &build)?;
+                Simulation::new(lattice, c, &MuscleCatalogue::default())
+            })
             .or_py(py)?;
         Ok(Self {
             sim,

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import pickle
 from collections.abc import Callable
@@ -259,3 +260,32 @@ def test_bad_chain_tether_is_named() -> None:
         Simulation.phantom(tissue=False, chain_tether=-1.0)
     with pytest.raises(InvalidInputError, match="chain_tether_release_n"):
         Simulation.phantom(tissue=False, chain_tether_release_n=-1.0)
+
+
+VISIBLE_HUMAN = Path(__file__).resolve().parents[3] / "shared" / "data" / "visible-human"
+
+
+def test_a_segmentation_tools_label_list_builds_the_leg_and_unknown_names_are_refused(tmp_path: Path) -> None:
+    """An ITK-SNAP label file with people's names builds the same leg as our own label
+    table; a label no structure is known by is refused unless asked otherwise."""
+    volume = VISIBLE_HUMAN / "vhf_left_leg_labels.nii.gz"
+    table = VISIBLE_HUMAN / "vhf_left_leg_labels.json"
+    if not volume.exists():
+        pytest.skip(f"{volume} is absent")
+    labels = json.loads(table.read_text())["labels"]
+    lines = ["# ITK-SnAP Label Description File"]
+    for key, rec in sorted(labels.items(), key=lambda kv: int(kv[0])):
+        name = {"background": "Clear Label", "fat": "Subcutaneous fat"}.get(rec["name"], "Left " + rec["name"].replace("_", " "))
+        lines.append(f'{key} 10 20 30 1 1 1 "{name}"')
+    lines.append('99 1 1 1 1 1 1 "Popliteal artery"')
+    itk = tmp_path / "leg-labels.txt"
+    itk.write_text("\n".join(lines) + "\n")
+    with pytest.raises(MyoSliceError) as info:
+        Simulation.from_nifti(volume, itk, tissue=False)
+    assert "label 99 'Popliteal artery'" in str(info.value)
+    with pytest.raises(InvalidInputError):
+        Simulation.from_nifti(volume, itk, unmapped="bogus", tissue=False)
+    ours = Simulation.from_nifti(volume, table, tissue=False)
+    theirs = Simulation.from_nifti(volume, itk, unmapped="fat", tissue=False)
+    assert theirs.muscle_names == ours.muscle_names
+    assert theirs.n_fat_elements == ours.n_fat_elements

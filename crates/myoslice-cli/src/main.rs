@@ -8,6 +8,7 @@ use clap::{Args, Parser, Subcommand};
 use myoslice::BuildReport;
 
 mod bench;
+mod labels;
 use myoslice::prelude::*;
 
 #[derive(Parser)]
@@ -35,6 +36,9 @@ enum Command {
     Slices(SlicesArgs),
     /// Measure a phantom definition (per-level outlines) from a labelled volume.
     PhantomMeasure(MeasureArgs),
+    /// Show how a label table or a segmentation tool's label list (ITK-SNAP, 3D Slicer)
+    /// reads: each label's name and the structure it maps to.
+    Labels(labels::LabelsArgs),
 }
 
 #[derive(Args)]
@@ -133,9 +137,13 @@ struct ModelArgs {
     /// NIfTI label volume (.nii or .nii.gz).
     #[arg(long, requires = "labels")]
     volume: Option<PathBuf>,
-    /// Label table (.json or .toml).
+    /// Label table (.json, .toml), ITK-SNAP label description file or 3D Slicer colour
+    /// table (see `myoslice labels`).
     #[arg(long, requires = "volume")]
     labels: Option<PathBuf>,
+    /// Label names no structure is known by: an error, or fat, or background.
+    #[arg(long, value_enum, default_value_t = labels::UnmappedArg::Error)]
+    unmapped: labels::UnmappedArg,
     /// Keep every K-th slice.
     #[arg(long, default_value_t = 5)]
     slice_step: usize,
@@ -163,7 +171,7 @@ fn load(m: &ModelArgs) -> Result<(LabelVolume, LabelTable, String)> {
     match (&m.volume, &m.labels) {
         (Some(v), Some(l)) => {
             let vol = read_nifti(v)?;
-            let table = LabelTable::from_path(l)?;
+            let table = LabelTable::from_path_with(l, m.unmapped.into())?;
             Ok((vol, table, v.display().to_string()))
         }
         _ => {
@@ -391,6 +399,7 @@ fn run(cli: &Cli) -> Result<()> {
             tissue_iterations: a.tissue_iterations,
         }),
         Command::Probe(a) => probe(a),
+        Command::Labels(a) => labels::run(a),
         Command::Slices(a) => {
             let (vol, table, _) = load(&a.model)?;
             let ks = myoslice::export::write_axial_slices(&vol, &table, &a.z_mm, &a.out)?;

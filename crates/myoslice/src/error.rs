@@ -107,6 +107,14 @@ impl Error {
         }
     }
 
+    /// A [`Error::Parse`] of the source `path` (a file, or a description of the text).
+    pub(crate) fn parse(path: impl Into<PathBuf>, reason: impl Into<String>) -> Self {
+        Error::Parse {
+            path: path.into(),
+            reason: reason.into(),
+        }
+    }
+
     pub(crate) fn write(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         Error::Write {
             path: path.into(),

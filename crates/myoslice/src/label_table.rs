@@ -4,7 +4,8 @@
 //! a top-level `labels` map from id (as a string) to a record with `name`, `kind`
 //! (`background | fat | bone | muscle`) and, for muscles, optional `origin` and `insertion`
 //! bone names. Other keys are allowed and ignored, so annotated tables load as they are.
-//! The same structure is read from JSON or TOML.
+//! The same structure is read from JSON or TOML. A segmentation tool's label list (ITK-SNAP,
+//! 3D Slicer) is read too, its names mapped by [`crate::label_names`].
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -12,6 +13,8 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
+use crate::io::{parse_label_list, sniff_label_list};
+use crate::label_names::{AnatomyNames, MappedLabel, Unmapped, map_labels};
 
 /// What a label stands for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -152,15 +155,41 @@ impl LabelTable {
         Self::from_raw(raw, origin)
     }
 
-    /// Reads a `.json` or `.toml` label table.
+    /// Reads a label table: our own `.json` or `.toml`, or a segmentation tool's label
+    /// list (an ITK-SNAP label description file, a 3D Slicer colour table), told apart
+    /// by content. A tool's names are mapped onto known structures
+    /// ([`crate::label_names`]); a name the table does not know is an error.
     pub fn from_path(path: impl AsRef<Path>) -> Result<Self> {
+        Self::from_path_with(path, Unmapped::Error)
+    }
+
+    /// [`Self::from_path`], taking a tool's unknown label names as `unmapped` says.
+    pub fn from_path_with(path: impl AsRef<Path>, unmapped: Unmapped) -> Result<Self> {
+        Ok(Self::read_mapped(path, unmapped)?.0)
+    }
+
+    /// [`Self::from_path_with`], with how each label of a tool's list was read (None for
+    /// our own formats, whose names are ours already).
+    pub fn read_mapped(
+        path: impl AsRef<Path>,
+        unmapped: Unmapped,
+    ) -> Result<(Self, Option<Vec<MappedLabel>>)> {
         let path = path.as_ref();
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
         let origin = path.display().to_string();
-        match path.extension().and_then(|e| e.to_str()) {
-            Some(e) if e.eq_ignore_ascii_case("toml") => Self::from_toml_str(&text, &origin),
-            _ => Self::from_json_str(&text, &origin),
+        let toml_ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+        if text.trim_start().starts_with('{') {
+            return Ok((Self::from_json_str(&text, &origin)?, None));
         }
+        if toml_ext || sniff_label_list(&text).is_none() {
+            return Ok((Self::from_toml_str(&text, &origin)?, None));
+        }
+        let list = parse_label_list(&text, &origin)?;
+        let (table, how) = map_labels(&list, AnatomyNames::builtin()?, unmapped, &origin)?;
+        Ok((table, Some(how)))
     }
 
     fn from_raw(raw: RawTable, origin: &str) -> Result<Self> {
@@ -233,10 +262,7 @@ impl LabelTable {
 }
 
 fn parse_err(origin: &str, reason: String) -> Error {
-    Error::Parse {
-        path: origin.into(),
-        reason,
-    }
+    Error::parse(origin, reason)
 }
 
 #[cfg(test)]

@@ -17,6 +17,7 @@ pub mod error;
 pub mod export;
 pub mod geometry;
 pub mod io;
+pub mod label_names;
 pub mod label_table;
 pub mod label_volume;
 pub mod lattice;
@@ -42,6 +43,7 @@ pub use slices::SliceReduction;
 pub mod prelude {
     pub use crate::error::{Error, Result};
     pub use crate::io::{read_nifti, read_png_stack};
+    pub use crate::label_names::Unmapped;
     pub use crate::label_table::{LabelTable, TissueKind};
     pub use crate::label_volume::LabelVolume;
     pub use crate::lattice::{BuildOptions, Lattice};

@@ -109,6 +109,49 @@ proptest! {
             prop_assert!(e.to_string().contains("hostile.json"), "{e}");
         }
     }
+
+    /// A segmentation tool's label list (ITK-SNAP, Slicer) with numbers and characters
+    /// changed: refused naming the file, or read and mapped (unknown names as fat).
+    #[test]
+    fn a_changed_label_list_is_refused_or_mapped(
+        slicer in any::<bool>(),
+        numbers in proptest::collection::vec((0usize..300, 0usize..12), 0..4),
+        edits in proptest::collection::vec((0usize..4000, any::<char>()), 0..3),
+    ) {
+        let text = mutate(if slicer { &SLICER_LIST } else { &ITK_SNAP_LIST }, &numbers, &edits);
+        let names = myoslice::label_names::AnatomyNames::builtin().unwrap();
+        let read = myoslice::io::parse_label_list(&text, "hostile.txt").and_then(|list| {
+            myoslice::label_names::map_labels(&list, names, Unmapped::Fat, "hostile.txt")
+        });
+        if let Err(e) = read {
+            prop_assert!(e.to_string().contains("hostile.txt"), "{e}");
+        }
+    }
+}
+
+/// The phantom's labels as ITK-SNAP and Slicer write them.
+static ITK_SNAP_LIST: LazyLock<String> = LazyLock::new(|| {
+    let mut s = String::from("# ITK-SnAP Label Description File\n");
+    for l in phantom_labels() {
+        s += &format!(
+            "{} 12 200 30 0.5 1 1 \"{}\"\n",
+            l.id,
+            l.name.replace('_', " ")
+        );
+    }
+    s
+});
+static SLICER_LIST: LazyLock<String> = LazyLock::new(|| {
+    let mut s = String::from("# Color table file seg.ctbl\n");
+    for l in phantom_labels() {
+        s += &format!("{} {} 12 200 30 255\n", l.id, l.name);
+    }
+    s
+});
+
+fn phantom_labels() -> Vec<myoslice::Label> {
+    let (_, table) = Phantom::default().generate().unwrap();
+    table.labels().to_vec()
 }
 
 #[test]

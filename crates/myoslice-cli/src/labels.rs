@@ -1,0 +1,97 @@
+//! `myoslice labels FILE`: how a label table or a segmentation tool's label list reads.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::{Args, ValueEnum};
+use myoslice::LabelTable;
+use myoslice::label_names::Unmapped;
+
+/// What to do with a label name no structure is known by.
+#[derive(Debug, Clone, Copy, Default, ValueEnum)]
+pub(crate) enum UnmappedArg {
+    /// Refuse the file, naming the labels.
+    #[default]
+    Error,
+    /// Take them as fat.
+    Fat,
+    /// Take them as background.
+    Ignore,
+}
+
+impl From<UnmappedArg> for Unmapped {
+    fn from(a: UnmappedArg) -> Self {
+        match a {
+            UnmappedArg::Error => Unmapped::Error,
+            UnmappedArg::Fat => Unmapped::Fat,
+            UnmappedArg::Ignore => Unmapped::Ignore,
+        }
+    }
+}
+
+#[derive(Args)]
+pub(crate) struct LabelsArgs {
+    /// Label table (.json, .toml), ITK-SNAP label description file or 3D Slicer colour
+    /// table (.ctbl, .txt).
+    file: PathBuf,
+    /// Label names no structure is known by: an error, or fat, or background.
+    #[arg(long, value_enum, default_value_t = UnmappedArg::Error)]
+    unmapped: UnmappedArg,
+}
+
+/// Prints each label, the name the file gives it and what it becomes; lists the names
+/// it cannot map before failing on them.
+pub(crate) fn run(a: &LabelsArgs) -> Result<()> {
+    // Read once taking unknown names as fat, to show every label; then as asked.
+    let (table, how) = LabelTable::read_mapped(&a.file, Unmapped::Fat)?;
+    let mut out = String::new();
+    match &how {
+        Some(how) => {
+            writeln!(
+                out,
+                "{:>5}  {:<32}  {:<28}  kind",
+                "label", "name in the file", "structure"
+            )?;
+            for m in how {
+                writeln!(
+                    out,
+                    "{:>5}  {:<32}  {:<28}  {}",
+                    m.id,
+                    m.source,
+                    m.structure.as_deref().unwrap_or("(not known)"),
+                    m.kind.as_str()
+                )?;
+            }
+            let unknown: Vec<&str> = how
+                .iter()
+                .filter(|m| m.structure.is_none())
+                .map(|m| m.source.as_str())
+                .collect();
+            if !unknown.is_empty() {
+                writeln!(
+                    out,
+                    "{} of {} labels not known: {}",
+                    unknown.len(),
+                    how.len(),
+                    unknown.join(", ")
+                )?;
+            }
+        }
+        None => {
+            writeln!(out, "{:>5}  {:<32}  kind", "label", "name")?;
+            for l in table.labels() {
+                writeln!(out, "{:>5}  {:<32}  {}", l.id, l.name, l.kind.as_str())?;
+            }
+        }
+    }
+    // A reader that stopped reading (`| head`) is no error.
+    match std::io::stdout().lock().write_all(out.as_bytes()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => return Err(e.into()),
+        _ => {}
+    }
+    // As it would be read with the option given (an error for unknown names by default).
+    LabelTable::from_path_with(&a.file, a.unmapped.into())?;
+    Ok(())
+}

@@ -1,0 +1,148 @@
+//! A segmentation's label list (ITK-SNAP, 3D Slicer) with the names people give
+//! structures reads as the same label table as our own format.
+
+#![allow(clippy::unwrap_used)] // tests fail loudly by design
+
+mod common;
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use myoslice::label_names::Unmapped;
+use myoslice::{LabelTable, TissueKind};
+
+/// How a person might name a structure in a segmentation tool.
+fn human(name: &str, k: usize) -> String {
+    let words = name.replace('_', " ");
+    match k % 4 {
+        0 => format!("Left {words}"),
+        1 => format!("M. {}", capitalised(&words)),
+        2 => format!("{} (L)", words.to_uppercase()),
+        _ => format!("{}_l", words.replace(' ', "")),
+    }
+}
+
+/// A fresh folder of this test process under the system's temporary folder.
+fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("myoslice-labels-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn capitalised(s: &str) -> String {
+    let mut c = s.chars();
+    c.next()
+        .map(|f| f.to_uppercase().chain(c).collect())
+        .unwrap_or_default()
+}
+
+fn itk_snap(table: &LabelTable) -> String {
+    let mut s = String::from(
+        "################################################\n\
+         # ITK-SnAP Label Description File\n\
+         # IDX   -R-  -G-  -B-  -A--  VIS MSH  LABEL\n\
+         ################################################\n",
+    );
+    for (k, l) in table.labels().iter().enumerate() {
+        let name = if l.kind == TissueKind::Background {
+            "Clear Label".to_string()
+        } else {
+            human(&l.name, k)
+        };
+        writeln!(
+            s,
+            "{:>5} {:>5} {:>4} {:>4} {:>8} 1 1 \"{name}\"",
+            l.id,
+            k * 5,
+            40,
+            200,
+            1
+        )
+        .unwrap();
+    }
+    s
+}
+
+fn slicer(table: &LabelTable) -> String {
+    let mut s = String::from("# Color table file seg.ctbl\n");
+    for (k, l) in table.labels().iter().enumerate() {
+        let name = human(&l.name, k + 1).replace(' ', "_");
+        writeln!(s, "{} {name} {} 40 200 255", l.id, k * 5).unwrap();
+    }
+    s
+}
+
+/// `table` written by each tool, read back: the same ids, names and kinds, and the
+/// same attachments where `table` has them.
+fn reads_back(table: &LabelTable, dir: &Path) {
+    for (file, text) in [
+        ("seg-labels.txt", itk_snap(table)),
+        ("seg.ctbl", slicer(table)),
+    ] {
+        let path = dir.join(file);
+        std::fs::write(&path, &text).unwrap();
+        let read = LabelTable::from_path(&path).unwrap_or_else(|e| panic!("{file}: {e}\n{text}"));
+        assert_eq!(read.labels().len(), table.labels().len(), "{file}");
+        for (a, b) in read.labels().iter().zip(table.labels()) {
+            assert_eq!((a.id, &a.name, a.kind), (b.id, &b.name, b.kind), "{file}");
+            if b.origin.is_some() || b.insertion.is_some() {
+                assert_eq!(
+                    (&a.origin, &a.insertion),
+                    (&b.origin, &b.insertion),
+                    "{file}: {}",
+                    b.name
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn the_phantoms_labels_written_by_itk_snap_and_slicer_read_back_as_its_table() {
+    let (_, table) = myoslice::phantom::Phantom::default().generate().unwrap();
+    let dir = scratch("phantom");
+    reads_back(&table, &dir);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn the_visible_human_labels_written_by_itk_snap_and_slicer_read_back_as_its_table() {
+    let path = common::vh_dir().join("vhf_left_leg_labels.json");
+    if !path.exists() {
+        eprintln!("skipped: {} is absent", path.display());
+        return;
+    }
+    let table = LabelTable::from_path(&path).unwrap();
+    let dir = scratch("vh");
+    reads_back(&table, &dir);
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn unknown_names_are_refused_by_default_and_taken_as_asked_otherwise() {
+    let dir = scratch("unknown");
+    let path = dir.join("seg.txt");
+    std::fs::write(
+        &path,
+        "0 0 0 0 0 0 0 \"Clear Label\"\n1 1 1 1 1 1 1 \"fat\"\n2 1 1 1 1 1 1 \"Femur\"\n\
+         3 1 1 1 1 1 1 \"Popliteal artery\"\n4 1 1 1 1 1 1 \"Sciatic nerve\"\n",
+    )
+    .unwrap();
+    let e = LabelTable::from_path(&path).unwrap_err().to_string();
+    assert!(
+        e.contains("seg.txt") && e.contains("label 3 'Popliteal artery', label 4 'Sciatic nerve'"),
+        "{e}"
+    );
+    let fat = LabelTable::from_path_with(&path, Unmapped::Fat).unwrap();
+    assert_eq!(
+        (fat.kind(3), fat.kind(4)),
+        (Some(TissueKind::Fat), Some(TissueKind::Fat))
+    );
+    let bg = LabelTable::from_path_with(&path, Unmapped::Ignore).unwrap();
+    assert_eq!(bg.kind(4), Some(TissueKind::Background));
+    // Our own formats are read as before, whatever the option.
+    let json = dir.join("t.json");
+    std::fs::write(&json, fat.to_json()).unwrap();
+    assert_eq!(LabelTable::from_path(&json).unwrap(), fat);
+    std::fs::remove_dir_all(dir).unwrap();
+}
