@@ -109,7 +109,7 @@ class Simulation:
     @staticmethod
     def from_nifti(
         volume: _StrPath,
-        labels: _StrPath,
+        labels: _StrPath | None = None,
         *,
         unmapped: str = "error",
         slice_step: int = 5,
@@ -126,10 +126,12 @@ class Simulation:
         chain_tether: float | None = None,
         chain_tether_release_n: float | None = None,
     ) -> Simulation:
-        """A model from a NIfTI label volume and its label table (JSON or TOML), or a
-        segmentation tool's label list (ITK-SNAP label description file, 3D Slicer colour
-        table) whose names are mapped onto known structures; ``unmapped`` (``"error"``,
-        ``"fat"`` or ``"ignore"``) says what to do with a name none is known by."""
+        """A model from a label volume (NIfTI-1 or NRRD) and its label table (JSON or
+        TOML), or a segmentation tool's label list (ITK-SNAP label description file, 3D
+        Slicer colour table) whose names are mapped onto known structures; without
+        ``labels``, a 3D Slicer segmentation's (``.seg.nrrd``) own segment names.
+        ``unmapped`` (``"error"``, ``"fat"`` or ``"ignore"``) says what to do with a name
+        none is known by."""
 
     @staticmethod
     def from_scenario(path: _StrPath) -> Simulation:

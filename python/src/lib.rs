@@ -113,16 +113,17 @@ impl PySimulation {
         })
     }
 
-    /// A NIfTI label volume with its label table (JSON or TOML), or a segmentation tool's
-    /// label list (ITK-SNAP, 3D Slicer), whose names are mapped onto known structures;
+    /// A label volume (NIfTI-1 or NRRD) with its label table (JSON or TOML) or a
+    /// segmentation tool's label list (ITK-SNAP, 3D Slicer), whose names are mapped onto
+    /// known structures; without one, a 3D Slicer segmentation's own segment names.
     /// `unmapped` ("error", "fat" or "ignore") says what to do with a name none is known by.
     #[staticmethod]
-    #[pyo3(signature = (volume, labels, *, unmapped = "error", slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, tissue_iterations = None, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, chain_tether_release_n = None))]
+    #[pyo3(signature = (volume, labels = None, *, unmapped = "error", slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, tissue_iterations = None, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, chain_tether_release_n = None))]
     #[allow(clippy::too_many_arguments)]
     fn from_nifti(
         py: Python<'_>,
         volume: PathBuf,
-        labels: PathBuf,
+        labels: Option<PathBuf>,
         unmapped: &str,
         slice_step: usize,
         rays: usize,
@@ -139,7 +140,9 @@ impl PySimulation {
         chain_tether_release_n: Option<f64>,
     ) -> PyResult<Self> {
         check_path(py, &volume, "volume")?;
-        check_path(py, &labels, "label table")?;
+        if let Some(labels) = &labels {
+            check_path(py, labels, "label table")?;
+        }
         let unmapped = match unmapped {
             "error" => Unmapped::Error,
             "fat" => Unmapped::Fat,
@@ -177,10 +180,7 @@ impl PySimulation {
         };
         let sim = py
             .detach(move || {
-                let v = myoslice::io::read_nifti(&volume)?;
-                let t = LabelTable::from_path_with(&labels, unmapped)?;
-                let lattice = myoslice::Lattice::build(&v, &t, &build)?;
-                Simulation::new(lattice, c, &MuscleCatalogue::default())
+                Simulation::from_segmentation(&volume, labels.as_deref(), unmapped, &build, c)
             })
             .or_py(py)?;
         Ok(Self {

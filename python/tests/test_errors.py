@@ -285,6 +285,10 @@ def test_a_segmentation_tools_label_list_builds_the_leg_and_unknown_names_are_re
     assert "label 99 'Popliteal artery'" in str(info.value)
     with pytest.raises(InvalidInputError):
         Simulation.from_nifti(volume, itk, unmapped="bogus", tissue=False)
+    # A NIfTI names none of its labels: the label file is needed.
+    with pytest.raises(MyoSliceError) as info:
+        Simulation.from_nifti(volume, tissue=False)
+    assert "names none of its labels" in str(info.value)
     ours = Simulation.from_nifti(volume, table, tissue=False)
     theirs = Simulation.from_nifti(volume, itk, unmapped="fat", tissue=False)
     assert theirs.muscle_names == ours.muscle_names

@@ -134,8 +134,9 @@ struct ModelArgs {
     /// Use the built-in phantom (the default when no volume is given).
     #[arg(long, conflicts_with_all = ["volume", "labels"])]
     phantom: bool,
-    /// NIfTI label volume (.nii or .nii.gz).
-    #[arg(long, requires = "labels")]
+    /// Label volume: NIfTI-1 (.nii, .nii.gz) or NRRD (.nrrd, .nhdr); a 3D Slicer
+    /// segmentation (.seg.nrrd) names its own labels.
+    #[arg(long)]
     volume: Option<PathBuf>,
     /// Label table (.json, .toml), ITK-SNAP label description file or 3D Slicer colour
     /// table (see `myoslice labels`).
@@ -168,13 +169,13 @@ struct BuildArgs {
 }
 
 fn load(m: &ModelArgs) -> Result<(LabelVolume, LabelTable, String)> {
-    match (&m.volume, &m.labels) {
-        (Some(v), Some(l)) => {
-            let vol = read_nifti(v)?;
-            let table = LabelTable::from_path_with(l, m.unmapped.into())?;
+    match &m.volume {
+        Some(v) => {
+            let (vol, table) =
+                myoslice::io::read_segmentation(v, m.labels.as_deref(), m.unmapped.into())?;
             Ok((vol, table, v.display().to_string()))
         }
-        _ => {
+        None => {
             let (vol, table) = myoslice::phantom::Phantom::default().generate()?;
             Ok((vol, table, "built-in phantom".into()))
         }

@@ -4,6 +4,9 @@
 
 use crate::error::{Error, Result};
 
+/// Label values with the names a file gives them, in file order.
+pub type LabelNames = Vec<(u16, String)>;
+
 /// Which tool's label list a text is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LabelListFormat {
@@ -40,7 +43,7 @@ pub fn sniff_label_list(text: &str) -> Option<LabelListFormat> {
 ///     assert_eq!(labels[1].0, 3);
 /// }
 /// ```
-pub fn parse_label_list(text: &str, origin: &str) -> Result<Vec<(u16, String)>> {
+pub fn parse_label_list(text: &str, origin: &str) -> Result<LabelNames> {
     let format = sniff_label_list(text).ok_or_else(|| {
         parse_err(
             origin,
@@ -53,7 +56,7 @@ pub fn parse_label_list(text: &str, origin: &str) -> Result<Vec<(u16, String)>> 
         LabelListFormat::ItkSnap => parse_itksnap_line,
         LabelListFormat::SlicerColors => parse_slicer_line,
     };
-    let mut out: Vec<(u16, String)> = Vec::new();
+    let mut out: LabelNames = Vec::new();
     for (n, line) in data_lines(text) {
         let (id, name) =
             parse(line).map_err(|why| parse_err(origin, format!("line {n}: {why}")))?;

@@ -253,15 +253,34 @@ impl Simulation {
         Self::new(lattice, config, &MuscleCatalogue::default())
     }
 
-    /// A NIfTI label volume and its label table.
+    /// A label volume (NIfTI-1 or NRRD) and its label table or a tool's label list (unknown
+    /// names are an error).
     pub fn from_nifti(
         volume: impl AsRef<std::path::Path>,
         labels: impl AsRef<std::path::Path>,
         build: &BuildOptions,
         config: SimulationConfig,
     ) -> Result<Self> {
-        let v = crate::io::read_nifti(volume)?;
-        let t = crate::label_table::LabelTable::from_path(labels)?;
+        Self::from_segmentation(
+            volume,
+            Some(labels.as_ref()),
+            crate::label_names::Unmapped::Error,
+            build,
+            config,
+        )
+    }
+
+    /// A label volume (NIfTI-1 or NRRD) with the meaning of its labels: a label table or
+    /// a tool's label list at `labels`, or, when None, the segment names of a 3D Slicer
+    /// segmentation (see [`crate::io::read_segmentation`]).
+    pub fn from_segmentation(
+        volume: impl AsRef<std::path::Path>,
+        labels: Option<&std::path::Path>,
+        unmapped: crate::label_names::Unmapped,
+        build: &BuildOptions,
+        config: SimulationConfig,
+    ) -> Result<Self> {
+        let (v, t) = crate::io::read_segmentation(volume, labels, unmapped)?;
         let lattice = Lattice::build(&v, &t, build)?;
         Self::new(lattice, config, &MuscleCatalogue::default())
     }
