@@ -123,7 +123,7 @@ fn a_slicer_segmentation_merges_its_layers_and_names_its_segments() {
     assert_eq!(segments.map(|s| s.len()), Some(3));
     // Its names map onto structures with no label file.
     let (volume, table) = read_segmentation(&path, None, Unmapped::Error).unwrap();
-    assert_eq!(volume, v.volume);
+    assert_eq!(volume, v.volume.canonical());
     assert_eq!(
         table.get(2).map(|l| l.name.as_str()),
         Some("semitendinosus")
@@ -180,6 +180,35 @@ fn the_phantom_written_as_nrrd_reads_back_identical() {
     );
     let back = parse_nrrd(&raw, Path::new("phantom.nrrd")).unwrap();
     assert_eq!(back.volume, volume);
+    // Saved in sagittal slices (k along x, toward the left) in an LPS frame, as another
+    // tool might: read back in the builder's order, the same volume.
+    let mut sagittal = Vec::with_capacity(nx * ny * nz);
+    for i in (0..nx).rev() {
+        for k in 0..nz {
+            for j in 0..ny {
+                sagittal.extend(volume.get(i, j, k).to_le_bytes());
+            }
+        }
+    }
+    // Voxel axes: j (fastest), k, then i reversed; LPS negates x and y.
+    let dir = |x: f64, y: f64, z: f64| format!("({},{},{})", -x, -y, z);
+    let raw = nrrd(
+        &format!(
+            "type: uint16\ndimension: 3\nspace: left-posterior-superior\nsizes: {ny} {nz} {nx}\n\
+             space directions: {} {} {}\nencoding: raw\nendian: little\nspace origin: {}\n",
+            dir(0.0, a[1][1], 0.0),
+            dir(0.0, 0.0, a[2][2]),
+            dir(-a[0][0], 0.0, 0.0),
+            dir(a[0][3] + a[0][0] * (nx - 1) as f64, a[1][3], a[2][3]),
+        ),
+        &sagittal,
+    );
+    let dir_ = scratch("sagittal");
+    let path = dir_.join("sagittal.nrrd");
+    std::fs::write(&path, &raw).unwrap();
+    let (read, _) = read_label_volume(&path).unwrap();
+    assert_eq!(read, volume);
+    std::fs::remove_dir_all(dir_).unwrap();
     // And builds the same lattice.
     let opts = BuildOptions::default();
     let (l0, l1) = (

@@ -11,8 +11,11 @@ pub use nifti::{MAX_VOLUME_BYTES, encode_nifti, parse_nifti, read_nifti, write_n
 pub use nrrd::{NrrdVolume, is_nrrd, parse_nrrd, read_nrrd};
 pub use png_stack::{read_png_stack, write_png_labels};
 
-/// Reads a label volume, NIfTI-1 or NRRD (told apart by content), with the label names
-/// the file itself carries (a 3D Slicer segmentation's segments; None otherwise).
+/// Reads a label volume, NIfTI-1 or NRRD (told apart by content), in the order the lattice
+/// builder slices it ([`crate::LabelVolume::canonical`]: a scan saved in sagittal or
+/// coronal slices, or in a left-posterior-superior frame, is reordered voxel for voxel),
+/// with the label names the file itself carries (a 3D Slicer segmentation's segments;
+/// None otherwise).
 pub fn read_label_volume(
     path: impl AsRef<std::path::Path>,
 ) -> crate::Result<(crate::LabelVolume, Option<LabelNames>)> {
@@ -20,9 +23,9 @@ pub fn read_label_volume(
     let raw = std::fs::read(path).map_err(|e| crate::Error::io(path, e))?;
     if is_nrrd(&raw) {
         let v = parse_nrrd(&raw, path)?;
-        Ok((v.volume, v.segments))
+        Ok((v.volume.canonical(), v.segments))
     } else {
-        Ok((parse_nifti(&raw, path)?, None))
+        Ok((parse_nifti(&raw, path)?.canonical(), None))
     }
 }
 
