@@ -7,7 +7,8 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use myoslice::LabelTable;
-use myoslice::label_names::Unmapped;
+use myoslice::io::{is_nrrd, read_nrrd};
+use myoslice::label_names::{AnatomyNames, Unmapped, map_labels};
 
 /// What to do with a label name no structure is known by.
 #[derive(Debug, Clone, Copy, Default, ValueEnum)]
@@ -33,8 +34,8 @@ impl From<UnmappedArg> for Unmapped {
 
 #[derive(Args)]
 pub(crate) struct LabelsArgs {
-    /// Label table (.json, .toml), ITK-SNAP label description file or 3D Slicer colour
-    /// table (.ctbl, .txt).
+    /// Label table (.json, .toml), ITK-SNAP label description file, 3D Slicer colour
+    /// table (.ctbl, .txt) or 3D Slicer segmentation (.seg.nrrd).
     file: PathBuf,
     /// Label names no structure is known by: an error, or fat, or background.
     #[arg(long, value_enum, default_value_t = UnmappedArg::Error)]
@@ -44,9 +45,39 @@ pub(crate) struct LabelsArgs {
 /// Prints each label, the name the file gives it and what it becomes; lists the names
 /// it cannot map before failing on them.
 pub(crate) fn run(a: &LabelsArgs) -> Result<()> {
-    // Read once taking unknown names as fat, to show every label; then as asked.
-    let (table, how) = LabelTable::read_mapped(&a.file, Unmapped::Fat)?;
+    // Read once taking unknown names as asked, or as fat where that would be an error, to
+    // show every label; then as asked.
+    let shown = match a.unmapped {
+        UnmappedArg::Error => Unmapped::Fat,
+        other => other.into(),
+    };
     let mut out = String::new();
+    let segmentation = std::fs::read(&a.file)
+        .ok()
+        .filter(|raw| is_nrrd(raw))
+        .map(|_| read_nrrd(&a.file))
+        .transpose()?;
+    let (table, how, segments) = match segmentation {
+        Some(v) => {
+            let Some(list) = v.segments else {
+                anyhow::bail!(
+                    "{}: a label map that names none of its labels (give its label file)",
+                    a.file.display()
+                );
+            };
+            if let Some(rule) = &v.merge {
+                writeln!(out, "{rule}")?;
+            }
+            let names = AnatomyNames::builtin()?;
+            let origin = a.file.display().to_string();
+            let (table, how) = map_labels(&list, names, shown, &origin)?;
+            (table, Some(how), Some((list, origin)))
+        }
+        None => {
+            let (table, how) = LabelTable::read_mapped(&a.file, shown)?;
+            (table, how, None)
+        }
+    };
     match &how {
         Some(how) => {
             writeln!(
@@ -92,6 +123,13 @@ pub(crate) fn run(a: &LabelsArgs) -> Result<()> {
         _ => {}
     }
     // As it would be read with the option given (an error for unknown names by default).
-    LabelTable::from_path_with(&a.file, a.unmapped.into())?;
+    match segments {
+        Some((list, origin)) => {
+            map_labels(&list, AnatomyNames::builtin()?, a.unmapped.into(), &origin)?;
+        }
+        None => {
+            LabelTable::from_path_with(&a.file, a.unmapped.into())?;
+        }
+    }
     Ok(())
 }

@@ -20,7 +20,7 @@ const IGNORED_WORDS: [&str; 16] = [
     "musculus", "muscle", "muscles", "os",
 ];
 
-/// "bone" is a filler too ("femur bone"), but not inside "hip bone": dropped last.
+/// "bone" is a filler too ("femur bone" reads as "femur", "hip bone" as "hip").
 const BONE_WORD: &str = "bone";
 
 /// The key a name is compared by: lower case; camelCase split; anything not a letter
@@ -58,6 +58,7 @@ pub fn normalise(name: &str) -> String {
 
 /// A structure myoslice knows, as the synonym table describes it.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Structure {
     /// Canonical name (that of the muscle catalogue and the skeleton).
     #[serde(skip)]
@@ -199,6 +200,8 @@ pub fn map_labels(
         reason,
     };
     let mut mapped: Vec<MappedLabel> = Vec::with_capacity(list.len());
+    // Names given so far (a set: a hostile list may have 65 536 labels).
+    let mut used = std::collections::BTreeSet::new();
     let mut missing = Vec::new();
     for (id, source) in list {
         let (structure, kind) = match names.lookup(source) {
@@ -221,7 +224,9 @@ pub fn map_labels(
         let taken = |n: &str| mapped.iter().any(|m| m.name == n);
         let name = match kind {
             TissueKind::Bone | TissueKind::Muscle => {
-                if let Some(prev) = mapped.iter().find(|m| m.name == base) {
+                if used.contains(&base)
+                    && let Some(prev) = mapped.iter().find(|m| m.name == base)
+                {
                     return Err(err(format!(
                         "labels {} '{}' and {id} '{source}' both read as {base}: merge them \
                          in the segmentation, or rename one",
@@ -233,6 +238,7 @@ pub fn map_labels(
             _ if !taken(&base) => base,
             _ => format!("{base}_{id}"),
         };
+        used.insert(name.clone());
         mapped.push(MappedLabel {
             id: *id,
             source: source.clone(),
@@ -243,9 +249,9 @@ pub fn map_labels(
     }
     if !missing.is_empty() {
         return Err(err(format!(
-            "no structure known by the name of label {} (`myoslice labels FILE` lists every \
-             label; `--unmapped fat` or `--unmapped ignore` takes such labels as fat or as \
-             background)",
+            "no structure known by the name of label {} (`myoslice labels FILE` lists how \
+             every label reads; to take such labels as fat or as background: `--unmapped \
+             fat|ignore` in the CLI, `unmapped=\"fat\"|\"ignore\"` in Python)",
             missing.join(", label ")
         )));
     }

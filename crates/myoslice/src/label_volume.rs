@@ -127,11 +127,13 @@ impl LabelVolume {
     /// assert_eq!(c.data(), &[9, 7]); // now increasing x
     /// assert_eq!(c.affine()[0], [2.0, 0.0, 0.0, 8.0]);
     /// ```
-    pub fn canonical(&self) -> Self {
+    pub fn canonical(self) -> Self {
         let a = &self.affine;
-        // Voxel axis of each world axis: the largest entries first, each axis once.
+        let sp = self.spacing_mm();
+        // Voxel axis of each world axis: the most aligned pairs first (direction cosines,
+        // whatever the voxel sizes), each axis once.
         let mut pairs: Vec<(f64, usize, usize)> = (0..3)
-            .flat_map(|r| (0..3).map(move |c| (a[r][c].abs(), r, c)))
+            .flat_map(|r| (0..3).map(move |c| (a[r][c].abs() / sp[c], r, c)))
             .collect();
         pairs.sort_by(|p, q| q.0.total_cmp(&p.0).then((p.1, p.2).cmp(&(q.1, q.2))));
         let mut axis_of = [usize::MAX; 3];
@@ -144,7 +146,7 @@ impl LabelVolume {
         }
         let flip: [bool; 3] = std::array::from_fn(|r| a[r][axis_of[r]] < 0.0);
         if axis_of == [0, 1, 2] && flip == [false; 3] {
-            return self.clone();
+            return self;
         }
         let dims: [usize; 3] = std::array::from_fn(|r| self.dims[axis_of[r]]);
         // New voxel (i, j, k) is old voxel `src`, whose index along old axis axis_of[r]
@@ -234,7 +236,14 @@ mod tests {
             out.sort();
             out
         };
-        for perm in [[0, 1, 2], [2, 0, 1], [1, 2, 0], [2, 1, 0]] {
+        for perm in [
+            [0, 1, 2],
+            [0, 2, 1],
+            [1, 0, 2],
+            [1, 2, 0],
+            [2, 0, 1],
+            [2, 1, 0],
+        ] {
             for flips in 0..8 {
                 // Store `v` with its axes permuted and flipped.
                 let nd: [usize; 3] = std::array::from_fn(|c| dims[perm[c]]);

@@ -15,6 +15,8 @@ pub mod body;
 pub mod contour;
 pub mod error;
 pub mod export;
+#[doc(hidden)]
+pub mod fuzz_targets;
 pub mod geometry;
 pub mod io;
 pub mod label_names;

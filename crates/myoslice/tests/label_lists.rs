@@ -107,12 +107,9 @@ fn the_phantoms_labels_written_by_itk_snap_and_slicer_read_back_as_its_table() {
 
 #[test]
 fn the_visible_human_labels_written_by_itk_snap_and_slicer_read_back_as_its_table() {
-    let path = common::vh_dir().join("vhf_left_leg_labels.json");
-    if !path.exists() {
-        eprintln!("skipped: {} is absent", path.display());
+    let Some((_, table)) = common::vh_leg() else {
         return;
-    }
-    let table = LabelTable::from_path(&path).unwrap();
+    };
     let dir = scratch("vh");
     reads_back(&table, &dir);
     std::fs::remove_dir_all(dir).unwrap();

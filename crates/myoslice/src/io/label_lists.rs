@@ -57,10 +57,11 @@ pub fn parse_label_list(text: &str, origin: &str) -> Result<LabelNames> {
         LabelListFormat::SlicerColors => parse_slicer_line,
     };
     let mut out: LabelNames = Vec::new();
+    let mut seen = std::collections::BTreeMap::new();
     for (n, line) in data_lines(text) {
         let (id, name) =
             parse(line).map_err(|why| parse_err(origin, format!("line {n}: {why}")))?;
-        if let Some((_, prev)) = out.iter().find(|(i, _)| *i == id) {
+        if let Some(prev) = seen.insert(id, out.len()).map(|i| &out[i].1) {
             return Err(parse_err(
                 origin,
                 format!("line {n}: label {id} is defined twice ('{prev}' and '{name}')"),

@@ -9,7 +9,7 @@ pub mod png_stack;
 pub use label_lists::{LabelListFormat, LabelNames, parse_label_list, sniff_label_list};
 pub use nifti::{MAX_VOLUME_BYTES, encode_nifti, parse_nifti, read_nifti, write_nifti};
 pub use nrrd::{NrrdVolume, is_nrrd, parse_nrrd, read_nrrd};
-pub use png_stack::{read_png_stack, write_png_labels};
+pub use png_stack::{decode_png_labels, read_png_stack, write_png_labels};
 
 /// Reads a label volume, NIfTI-1 or NRRD (told apart by content), in the order the lattice
 /// builder slices it ([`crate::LabelVolume::canonical`]: a scan saved in sagittal or
@@ -52,7 +52,14 @@ pub fn read_segmentation(
     let volume = volume.as_ref();
     let (v, segments) = read_label_volume(volume)?;
     let table = match (labels, segments) {
-        (Some(l), _) => crate::LabelTable::from_path_with(l, unmapped)?,
+        (Some(_), Some(_)) => {
+            return Err(crate::Error::parse(
+                volume,
+                "a 3D Slicer segmentation names its own segments (renumbered 1, 2, ... in \
+                 the file's order), so no label file applies to it: leave the label file out",
+            ));
+        }
+        (Some(l), None) => crate::LabelTable::from_path_with(l, unmapped)?,
         (None, Some(list)) => {
             let names = crate::label_names::AnatomyNames::builtin()?;
             let origin = volume.display().to_string();

@@ -44,14 +44,32 @@ pub fn parse_nrrd(raw: &[u8], path: &Path) -> Result<NrrdVolume> {
         reason,
     };
     let h = Header::parse(raw).map_err(err)?;
-    let payload = match &h.data_file {
-        None => raw.get(h.data_start..).unwrap_or_default().to_vec(),
-        Some(f) => {
-            let p = path.parent().unwrap_or(Path::new(".")).join(f);
-            std::fs::read(&p).map_err(|e| Error::io(&p, e))?
-        }
+    let payload: std::borrow::Cow<'_, [u8]> = match &h.data_file {
+        None => raw.get(h.data_start..).unwrap_or_default().into(),
+        Some(f) => read_detached(&path.parent().unwrap_or(Path::new(".")).join(f), &h)?.into(),
     };
     h.volume(&payload).map_err(err)
+}
+
+/// A detached data file, read no further than the header's voxels can reach: a regular
+/// file only (not `/dev/zero` or a pipe).
+fn read_detached(p: &Path, h: &Header) -> Result<Vec<u8>> {
+    let file = std::fs::File::open(p).map_err(|e| Error::io(p, e))?;
+    let meta = file.metadata().map_err(|e| Error::io(p, e))?;
+    if !meta.is_file() {
+        return Err(Error::parse(p, "the NRRD data file is not a regular file"));
+    }
+    let limit = if h.gzip {
+        MAX_VOLUME_BYTES
+    } else {
+        // The voxels, the bytes skipped, and room for skipped lines.
+        h.voxel_bytes() + h.byte_skip as u64 + (h.line_skip as u64) * 4096
+    };
+    let mut out = Vec::new();
+    file.take(limit)
+        .read_to_end(&mut out)
+        .map_err(|e| Error::io(p, e))?;
+    Ok(out)
 }
 
 /// Whether bytes start like a NRRD file.
@@ -124,6 +142,7 @@ struct Header {
     gzip: bool,
     big: bool,
     byte_skip: usize,
+    line_skip: usize,
     /// Voxel-to-world affine (mm, right-anterior-superior).
     affine: [[f64; 4]; 3],
     data_file: Option<String>,
@@ -221,6 +240,15 @@ impl Header {
                 .parse()
                 .map_err(|_| format!("byte skip '{s}' is not a whole number (-1 is not read)"))?,
         };
+        let line_skip = match get("line skip") {
+            None => 0,
+            Some(s) => s
+                .parse()
+                .map_err(|_| format!("line skip '{s}' is not a whole number"))?,
+        };
+        if gzip && line_skip > 0 {
+            return Err("line skip before gzip data is not read".into());
+        }
         let data_file = get("data file").or(get("datafile")).map(str::to_string);
         if let Some(f) = &data_file
             && (f.starts_with("LIST") || f.split_whitespace().count() > 1)
@@ -234,6 +262,18 @@ impl Header {
             get("spacings"),
             dimension,
         )?;
+        if let Some(k) = get("kinds") {
+            let kinds: Vec<&str> = k.split_whitespace().collect();
+            let spatial = |k: &str| matches!(k, "domain" | "space");
+            let ok = kinds.len() == dimension
+                && kinds[..dimension - 3].iter().all(|k| !spatial(k))
+                && kinds[dimension - 3..].iter().all(|k| spatial(k));
+            if !ok {
+                return Err(format!(
+                    "kinds '{k}': three spatial axes (domain or space) expected, after a layer axis in 4-D"
+                ));
+            }
+        }
         Ok(Self {
             ty,
             sizes,
@@ -241,6 +281,7 @@ impl Header {
             gzip,
             big,
             byte_skip,
+            line_skip,
             affine,
             data_file,
             data_start,
@@ -248,21 +289,36 @@ impl Header {
         })
     }
 
+    /// Bytes of voxel data the sizes and type claim (at most the cap, see [`Self::parse`]).
+    fn voxel_bytes(&self) -> u64 {
+        self.sizes.iter().map(|s| *s as u64).product::<u64>() * self.ty.bytes() as u64
+    }
+
     fn volume(&self, payload: &[u8]) -> std::result::Result<NrrdVolume, String> {
-        let body = payload
-            .get(self.byte_skip..)
-            .ok_or("byte skip reaches past the data")?;
-        let n: usize = self.sizes.iter().product();
-        let want = n * self.ty.bytes();
+        let mut body = payload;
+        for _ in 0..self.line_skip {
+            let end = body
+                .iter()
+                .position(|&b| b == b'\n')
+                .ok_or("line skip reaches past the data")?;
+            body = &body[end + 1..];
+        }
+        let want = self.voxel_bytes() as usize;
+        // Byte skip counts in the data as stored after decompression.
         let bytes: std::borrow::Cow<'_, [u8]> = if self.gzip {
-            let mut out = Vec::with_capacity(want.min(1 << 26));
+            let mut out = Vec::new();
             flate2::read::MultiGzDecoder::new(body)
-                .take(want as u64)
+                .take((want + self.byte_skip) as u64)
                 .read_to_end(&mut out)
                 .map_err(|e| format!("gzip data is corrupt or truncated ({e})"))?;
-            out.into()
+            out.get(self.byte_skip..)
+                .ok_or("byte skip reaches past the data")?
+                .to_vec()
+                .into()
         } else {
-            body.into()
+            body.get(self.byte_skip..)
+                .ok_or("byte skip reaches past the data")?
+                .into()
         };
         if bytes.len() < want {
             return Err(format!(
@@ -303,7 +359,13 @@ impl Header {
         value: impl Fn(usize) -> i64,
     ) -> std::result::Result<Merged, String> {
         let mut by_value: BTreeMap<(usize, i64), u16> = BTreeMap::new();
-        let mut names = Vec::new();
+        // Voxels of no segment: the background.
+        let mut names = vec![(0u16, "Background".to_string())];
+        // Segmentations before layers were shared (Slicer 4.10) store each segment in a
+        // layer of its own, with no `_Layer` or `_LabelValue`.
+        let legacy = self.layers > 1
+            && self.layers == self.segments.len()
+            && self.segments.values().all(|f| !f.contains_key("Layer"));
         for (k, (n, f)) in self.segments.iter().enumerate() {
             let name = f
                 .get("Name")
@@ -317,7 +379,7 @@ impl Header {
                 })
             };
             let value = parse("LabelValue", 1)?;
-            let layer = parse("Layer", 0)?;
+            let layer = parse("Layer", if legacy { k as i64 } else { 0 })?;
             if layer < 0 || layer as usize >= self.layers {
                 return Err(format!(
                     "segment {n} '{name}' lies in layer {layer}, of {} layers",
@@ -332,21 +394,37 @@ impl Header {
             }
             names.push((id, name));
         }
-        if names.is_empty() {
+        if names.len() == 1 {
             return Err(format!(
                 "{} layers but no Segment{{N}}_Name fields: not a segmentation to merge",
                 self.layers
             ));
         }
+        // Label value → label, per layer (0: no segment; the values are small).
+        let used = by_value.keys().map(|k| k.0 + 1).max().unwrap_or(0);
+        let mut lut = vec![[0u16; 256]; used];
+        for (&(layer, v), &id) in &by_value {
+            if let Ok(v) = u8::try_from(v) {
+                lut[layer][usize::from(v)] = id;
+            }
+        }
         let mut data = vec![0u16; cells];
         for (c, d) in data.iter_mut().enumerate() {
             for layer in 0..self.layers {
                 let v = value(c * self.layers + layer);
-                if v != 0 {
-                    *d = *by_value.get(&(layer, v)).ok_or_else(|| {
-                        format!("voxel {c}: value {v} of layer {layer} is no segment's label value")
-                    })?;
+                if v == 0 {
+                    continue;
                 }
+                let fast = u8::try_from(v)
+                    .ok()
+                    .and_then(|b| lut.get(layer).map(|t| t[usize::from(b)]));
+                let id = match fast {
+                    Some(id) if id != 0 => Some(id),
+                    _ => by_value.get(&(layer, v)).copied(),
+                };
+                *d = id.ok_or_else(|| {
+                    format!("voxel {c}: value {v} of layer {layer} is no segment's label value")
+                })?;
             }
         }
         let merge = (self.layers > 1).then(|| {
@@ -354,7 +432,7 @@ impl Header {
                 "{} layers merged: each segment is its own label (1..={}), and a voxel in \
                  segments of several layers takes the last layer's",
                 self.layers,
-                names.len()
+                names.len() - 1
             )
         });
         Ok((data, Some(names), merge))
@@ -398,12 +476,16 @@ fn affine(
     match (directions, spacings) {
         (Some(d), _) => {
             let vectors: Vec<&str> = d.split_whitespace().collect();
-            let spatial: Vec<&str> = vectors.iter().copied().filter(|v| *v != "none").collect();
-            if vectors.len() != dimension || spatial.len() != 3 {
+            let layer_axes = dimension.saturating_sub(3);
+            let ok = vectors.len() == dimension
+                && vectors[..layer_axes].iter().all(|v| *v == "none")
+                && vectors[layer_axes..].iter().all(|v| *v != "none");
+            if !ok {
                 return Err(format!(
-                    "space directions '{d}': 3 vectors (and 'none' for a layer axis) expected"
+                    "space directions '{d}': 3 vectors expected (after 'none' for a layer axis in 4-D)"
                 ));
             }
+            let spatial = &vectors[layer_axes..];
             for (c, v) in spatial.iter().enumerate() {
                 let x = vector(v)?;
                 for r in 0..3 {
@@ -412,17 +494,24 @@ fn affine(
             }
         }
         (None, Some(s)) => {
-            let v: Vec<f64> = s
-                .split_whitespace()
-                .filter(|t| *t != "nan" && *t != "NaN")
-                .map(|t| {
-                    t.parse::<f64>()
-                        .map_err(|_| format!("spacing '{t}' is not a number"))
+            let tokens: Vec<&str> = s.split_whitespace().collect();
+            let layer_axes = dimension.saturating_sub(3);
+            if tokens.len() != dimension
+                || !tokens[..layer_axes]
+                    .iter()
+                    .all(|t| t.eq_ignore_ascii_case("nan"))
+            {
+                return Err(format!(
+                    "spacings '{s}': 3 spatial spacings expected (after NaN for a layer axis in 4-D)"
+                ));
+            }
+            let v: Vec<f64> = tokens[layer_axes..]
+                .iter()
+                .map(|t| match t.parse::<f64>() {
+                    Ok(x) if x.is_finite() && x != 0.0 => Ok(x),
+                    _ => Err(format!("spacing '{t}' is not a non-zero number")),
                 })
                 .collect::<std::result::Result<_, _>>()?;
-            if v.len() != 3 {
-                return Err(format!("spacings '{s}': 3 spatial spacings expected"));
-            }
             for r in 0..3 {
                 a[r][r] = v[r];
             }

@@ -19,7 +19,6 @@
 //! need the `[colors]` map.
 
 use std::collections::BTreeMap;
-use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
@@ -184,43 +183,66 @@ pub fn read_png_stack(
     Ok((volume, table))
 }
 
+/// Most bytes one decoded PNG slice may take (512 MiB: an 8192 × 8192 16-bit RGBA
+/// image), checked against the image's header before the pixels are allocated.
+pub const MAX_SLICE_BYTES: u64 = 512 << 20;
+
 fn read_png_labels(path: &Path, colors: &BTreeMap<[u8; 3], u16>) -> Result<(u32, u32, Vec<u16>)> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    decode_png_labels(&bytes, path, colors)
+}
+
+/// The labels of one PNG slice (`path` only names it in messages): grey values are label
+/// ids, colours are looked up in `colors`. Returns width, height and the labels, rows
+/// first.
+pub fn decode_png_labels(
+    bytes: &[u8],
+    path: &Path,
+    colors: &BTreeMap<[u8; 3], u16>,
+) -> Result<(u32, u32, Vec<u16>)> {
     let perr = |reason: String| Error::Png {
         path: path.into(),
         reason,
     };
-    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
-    let decoder = png::Decoder::new(BufReader::new(file));
+    let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
     let mut reader = decoder.read_info().map_err(|e| perr(e.to_string()))?;
     let size = reader
         .output_buffer_size()
-        .ok_or_else(|| perr("image too large".into()))?;
-    let mut buf = vec![0u8; size];
-    let info = reader
-        .next_frame(&mut buf)
-        .map_err(|e| perr(e.to_string()))?;
-    let (w, h) = (info.width, info.height);
-    let n = (w * h) as usize;
-    let ch = match info.color_type {
+        .filter(|s| *s as u64 <= MAX_SLICE_BYTES)
+        .ok_or_else(|| {
+            let i = reader.info();
+            perr(format!(
+                "a {}x{} image needs more than the {MAX_SLICE_BYTES}-byte cap on one slice",
+                i.width, i.height
+            ))
+        })?;
+    // What the decoder will write, checked before the pixels are allocated.
+    let (color_type, bit_depth) = reader.output_color_type();
+    if !matches!(bit_depth, png::BitDepth::Eight | png::BitDepth::Sixteen) {
+        return Err(perr(format!(
+            "{bit_depth:?}-bit images are not supported; use 8 or 16 bit"
+        )));
+    }
+    let ch = match color_type {
         png::ColorType::Grayscale | png::ColorType::Indexed => 1,
         png::ColorType::GrayscaleAlpha => 2,
         png::ColorType::Rgb => 3,
         png::ColorType::Rgba => 4,
     };
-    let wide = info.bit_depth == png::BitDepth::Sixteen;
-    if !matches!(
-        info.bit_depth,
-        png::BitDepth::Eight | png::BitDepth::Sixteen
-    ) {
-        return Err(perr(format!(
-            "{:?}-bit images are not supported; use 8 or 16 bit",
-            info.bit_depth
-        )));
-    }
+    let wide = bit_depth == png::BitDepth::Sixteen;
+    let mut buf = vec![0u8; size];
+    let info = reader
+        .next_frame(&mut buf)
+        .map_err(|e| perr(e.to_string()))?;
+    let (w, h) = (info.width, info.height);
+    let n = w as usize * h as usize;
     let bpp = ch * if wide { 2 } else { 1 };
     let mut out = Vec::with_capacity(n);
     for row in 0..h as usize {
-        let line = &buf[row * info.line_size..row * info.line_size + w as usize * bpp];
+        let start = row * info.line_size;
+        let line = buf
+            .get(start..start + w as usize * bpp)
+            .ok_or_else(|| perr(format!("row {row} is shorter than {w} pixels")))?;
         for px in line.chunks_exact(bpp) {
             let sample = |c: usize| -> u16 {
                 if wide {

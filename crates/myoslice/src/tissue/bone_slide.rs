@@ -319,7 +319,8 @@ fn surface_offset(sdf: &BoneSdf, mesh: &TriMesh, p: Vec3) -> (f32, Vec3) {
         return (s.distance, s.normal);
     }
     let proj = mesh.project_local_point(p, false);
-    let inside = sample.map_or(proj.is_inside, |s| s.distance < 0.0);
+    // Outside the field's grid is outside the bone.
+    let inside = sample.is_some_and(|s| s.distance < 0.0);
     let off = p - proj.point;
     let d = off.length();
     let n = if d > 0.0 { off / d } else { Vec3::ZERO };

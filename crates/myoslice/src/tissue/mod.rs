@@ -9,6 +9,7 @@ mod crease;
 mod distance_grid;
 mod fat_keep_out;
 mod fat_lanes;
+mod fat_on_muscle;
 pub mod fat_solver;
 mod guard;
 mod guard_tally;
@@ -58,16 +59,6 @@ pub use bone_overlap::BoneOverlap;
 use bone_slide::{BoneMesh, BoneSlide};
 use fat_keep_out::FatKeepOut;
 use guard::Guard;
-
-/// Share of a muscle surface's sliding (along the fat layer) that drags the fat over it.
-const FASCIA_DRAG: f32 = 0.2;
-
-/// Share of the way to its target across the fat layer an inner vertex facing a muscle
-/// is pulled each iteration, and along the muscle (see [`Tissue::apply_muscles`]).
-/// Pulled along as hard as across, the fat was held where it folded and muscles came
-/// out through it; much weaker, more muscle came out (docs/tissue-history.md).
-const PULL_ACROSS: f32 = 0.7;
-const PULL_ALONG: f32 = 0.15;
 
 /// Extra distance (m) from the contact plane per fat layer below the skin.
 const LAYER_GAP: f32 = 0.001;
@@ -437,47 +428,21 @@ impl Tissue {
         );
         phases.knee_fold_s = lap.lap();
         let (safe, weights) = (&sc.safe, &sc.weights);
-        // Where each inner vertex facing a muscle goes: with its reference muscle vertex,
-        // keeping its rest offset from it turned as the tissue about it turns (the
-        // paper's moving vector alone would shear thin fat at large angles).
-        let (muscles, fat_rest, layers) = (&self.muscles, &self.fat.rest, self.layers);
-        sc.muscle_targets.clear();
-        sc.muscle_targets
-            .par_extend(
-                fixed
-                    .muscle_ref
-                    .par_iter()
-                    .enumerate()
-                    .filter_map(|(v, r)| {
-                        let (m, mv) = (*r)?;
-                        let shape = &muscles[m as usize];
-                        let turn = tq * Quat::from_axis_angle(fold.axis, theta * weights[v]);
-                        let offset = fat_rest[v] - shape.rest[mv as usize];
-                        let follow = shape.current[mv as usize] + turn * offset;
-                        // Across the layer the fat follows the muscle fully (a bulge pushes the
-                        // skin out); along it the muscle glides under its fascia and drags the fat
-                        // only partly (following its sliding fully shears the elements inside out).
-                        let (base, outer) = (safe[v], safe[v + layers]);
-                        let n = (outer - base).normalize_or_zero();
-                        let d = follow - base;
-                        let across = n * d.dot(n);
-                        let along = (d - across) * FASCIA_DRAG;
-                        // Across it, the fat keeps its rest offset from the muscle's surface where
-                        // the fat now lies over it, not from the vertex it lay over at rest: a
-                        // muscle that slides far under the fat (a gastrocnemius as the knee bends)
-                        // would otherwise carry the fat over its own tapering ends, and through
-                        // neighbouring tissue.
-                        let across = shape
-                            .surface_under(mv, base + along)
-                            .map_or(across, |q| n * (q + turn * offset - base).dot(n));
-                        Some((v as u32, base + across + along, n))
-                    }),
-            );
+        fat_on_muscle::targets(
+            &fixed.muscle_ref,
+            &self.muscles,
+            &self.fat.rest,
+            (safe, weights),
+            self.layers,
+            (tq, fold.axis, theta),
+            &mut sc.muscle_targets,
+        );
         // First guess, from the fold (so nothing accumulates): each radial column of
         // vertices moves with its inner vertex where that follows a muscle (across the
         // layer as a whole, along it the skin by half as much); part of the last
         // update's correction is carried over (inertia with damping).
         let momentum = self.config.momentum as f32;
+        let layers = self.layers;
         sc.guess.clone_from(safe);
         for &(inner, target, _) in &sc.muscle_targets {
             // Inner vertices are layer 0 of their column (see `FatLattice::vertex_index`).
@@ -527,12 +492,12 @@ impl Tissue {
             }
         }
         let (targets, limits) = (&sc.muscle_targets, &sc.skin_limits);
-        self.apply_muscles(targets);
+        fat_on_muscle::pull(&mut self.fat.x, targets);
         self.apply_contact(&contact, gap, limits);
         let k = self.config.stiffness as f32;
         for _ in 0..self.config.iterations {
             self.fat.iterate(k);
-            self.apply_muscles(targets);
+            fat_on_muscle::pull(&mut self.fat.x, targets);
             self.apply_contact(&contact, gap, limits);
         }
         phases.shape_matching_s = lap.lap();
@@ -562,20 +527,6 @@ impl Tissue {
         Front {
             phases,
             shapes_finite,
-        }
-    }
-
-    /// Pulls inner vertices facing a muscle toward their targets (the paper's rule, see
-    /// [`FASCIA_DRAG`]): across the layer (along `n`, the third field) strongly but not
-    /// rigidly, so that millimetre noise of the muscle surface cannot fold the thin fat
-    /// elements; along the muscle weakly, so that the fat glides on its fascia where the
-    /// elements about it pull. Shape matching shares the rest.
-    fn apply_muscles(&mut self, targets: &[(u32, Vec3, Vec3)]) {
-        for &(v, target, n) in targets {
-            let cur = self.fat.x[v as usize];
-            let d = target - cur;
-            let across = n * d.dot(n);
-            self.fat.x[v as usize] = cur + across * PULL_ACROSS + (d - across) * PULL_ALONG;
         }
     }
 
