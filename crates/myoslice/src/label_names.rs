@@ -221,7 +221,7 @@ pub fn map_labels(
         let base = structure
             .clone()
             .unwrap_or_else(|| kind.as_str().to_string());
-        let taken = |n: &str| mapped.iter().any(|m| m.name == n);
+        let taken = |n: &str| used.contains(n);
         let name = match kind {
             TissueKind::Bone | TissueKind::Muscle => {
                 if used.contains(&base)
