@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use myoslice::LabelTable;
-use myoslice::io::{is_nrrd, read_nrrd};
+use myoslice::io::{is_nrrd, parse_nrrd};
 use myoslice::label_names::{AnatomyNames, Unmapped, map_labels};
 
 /// What to do with a label name no structure is known by.
@@ -52,10 +52,11 @@ pub(crate) fn run(a: &LabelsArgs) -> Result<()> {
         other => other.into(),
     };
     let mut out = String::new();
+    // Read once: a segmentation is parsed from these bytes, a label file as text.
     let segmentation = std::fs::read(&a.file)
         .ok()
         .filter(|raw| is_nrrd(raw))
-        .map(|_| read_nrrd(&a.file))
+        .map(|raw| parse_nrrd(&raw, &a.file))
         .transpose()?;
     let (table, how, segments) = match segmentation {
         Some(v) => {

@@ -104,10 +104,8 @@ impl AnatomyNames {
     /// Parses a synonym table (`[structure.NAME]` with `kind`, `origin`, `insertion` and
     /// `names`); a name that normalises like another structure's is an error.
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Self> {
-        let raw: RawNames = toml::from_str(text).map_err(|e| Error::Parse {
-            path: origin.into(),
-            reason: e.to_string(),
-        })?;
+        let raw: RawNames =
+            toml::from_str(text).map_err(|e| Error::parse(origin, e.to_string()))?;
         let mut structures = Vec::with_capacity(raw.structure.len());
         let mut index = BTreeMap::new();
         for (name, mut s) in raw.structure {
@@ -116,25 +114,22 @@ impl AnatomyNames {
             for n in std::iter::once(&s.name).chain(&s.names) {
                 let key = normalise(n);
                 if key.is_empty() {
-                    return Err(Error::Parse {
-                        path: origin.into(),
-                        reason: format!(
-                            "'{}': the name '{n}' has no words left to compare",
-                            s.name
-                        ),
-                    });
+                    return Err(Error::parse(
+                        origin,
+                        format!("'{}': the name '{n}' has no words left to compare", s.name),
+                    ));
                 }
                 if let Some(&j) = index.get(&key)
                     && j != i
                 {
                     let other: &Structure = &structures[j];
-                    return Err(Error::Parse {
-                        path: origin.into(),
-                        reason: format!(
+                    return Err(Error::parse(
+                        origin,
+                        format!(
                             "'{n}' of '{}' reads as '{key}', a name of '{}' too",
                             s.name, other.name
                         ),
-                    });
+                    ));
                 }
                 index.insert(key, i);
             }
@@ -195,10 +190,7 @@ pub fn map_labels(
     unmapped: Unmapped,
     origin: &str,
 ) -> Result<(LabelTable, Vec<MappedLabel>)> {
-    let err = |reason: String| Error::Parse {
-        path: origin.into(),
-        reason,
-    };
+    let err = |reason: String| Error::parse(origin, reason);
     let mut mapped: Vec<MappedLabel> = Vec::with_capacity(list.len());
     // Names given so far (a set: a hostile list may have 65 536 labels).
     let mut used = std::collections::BTreeSet::new();

@@ -21,14 +21,9 @@ fn tissue_bits(sim: &Simulation) -> (Vec<[u32; 3]>, u64, (u64, u64)) {
     (v, sim.knee_angle().to_bits(), (g.updates, g.vertices))
 }
 
-/// The flexors at full excitation for `seconds` from rest, in steps of 10 ms.
+/// The hamstrings at full excitation for `seconds` from rest, in steps of 10 ms.
 fn flex(sim: &mut Simulation, seconds: f64) {
-    for m in [
-        "semitendinosus",
-        "semimembranosus",
-        "biceps_femoris_long",
-        "biceps_femoris_short",
-    ] {
+    for m in common::HAMSTRINGS {
         sim.set_excitation(m, 1.0).unwrap();
     }
     for _ in 0..(seconds / 0.01).round() as usize {

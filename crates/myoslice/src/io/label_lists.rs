@@ -45,11 +45,10 @@ pub fn sniff_label_list(text: &str) -> Option<LabelListFormat> {
 /// ```
 pub fn parse_label_list(text: &str, origin: &str) -> Result<LabelNames> {
     let format = sniff_label_list(text).ok_or_else(|| {
-        parse_err(
+        Error::parse(
             origin,
             "neither an ITK-SNAP label description file (`IDX R G B A VIS MSH \"LABEL\"`) nor a \
-             3D Slicer colour table (`id name R G B A`)"
-                .into(),
+             3D Slicer colour table (`id name R G B A`)",
         )
     })?;
     let parse = match format {
@@ -60,9 +59,9 @@ pub fn parse_label_list(text: &str, origin: &str) -> Result<LabelNames> {
     let mut seen = std::collections::BTreeMap::new();
     for (n, line) in data_lines(text) {
         let (id, name) =
-            parse(line).map_err(|why| parse_err(origin, format!("line {n}: {why}")))?;
+            parse(line).map_err(|why| Error::parse(origin, format!("line {n}: {why}")))?;
         if let Some(prev) = seen.insert(id, out.len()).map(|i| &out[i].1) {
-            return Err(parse_err(
+            return Err(Error::parse(
                 origin,
                 format!("line {n}: label {id} is defined twice ('{prev}' and '{name}')"),
             ));
@@ -137,10 +136,6 @@ fn parse_slicer_line(line: &str) -> std::result::Result<(u16, String), String> {
     }
     let name = fields[1..fields.len() - 4].join(" ");
     Ok((id, name))
-}
-
-fn parse_err(origin: &str, reason: String) -> Error {
-    Error::parse(origin, reason)
 }
 
 #[cfg(test)]

@@ -39,10 +39,7 @@ pub fn read_nrrd(path: impl AsRef<Path>) -> Result<NrrdVolume> {
 
 /// Parses NRRD bytes; `path` names the file in messages and locates a detached data file.
 pub fn parse_nrrd(raw: &[u8], path: &Path) -> Result<NrrdVolume> {
-    let err = |reason: String| Error::Parse {
-        path: path.to_path_buf(),
-        reason,
-    };
+    let err = |reason: String| Error::parse(path, reason);
     let h = Header::parse(raw).map_err(err)?;
     let payload: std::borrow::Cow<'_, [u8]> = match &h.data_file {
         None => raw.get(h.data_start..).unwrap_or_default().into(),
@@ -311,10 +308,11 @@ impl Header {
                 .take((want + self.byte_skip) as u64)
                 .read_to_end(&mut out)
                 .map_err(|e| format!("gzip data is corrupt or truncated ({e})"))?;
-            out.get(self.byte_skip..)
-                .ok_or("byte skip reaches past the data")?
-                .to_vec()
-                .into()
+            if self.byte_skip > out.len() {
+                return Err("byte skip reaches past the data".into());
+            }
+            out.drain(..self.byte_skip);
+            out.into()
         } else {
             body.get(self.byte_skip..)
                 .ok_or("byte skip reaches past the data")?
