@@ -6,7 +6,7 @@ a fresh copy: writing to it does not change the simulation.
 """
 
 import os
-from typing import TypeAlias, TypedDict, final
+from typing import Any, TypeAlias, TypedDict, final
 
 import numpy as np
 import numpy.typing as npt
@@ -112,6 +112,7 @@ class Simulation:
         labels: _StrPath | None = None,
         *,
         unmapped: str = "error",
+        names: _StrPath | None = None,
         slice_step: int = 5,
         rays: int = 48,
         body_mass_kg: float = 60.0,
@@ -126,12 +127,22 @@ class Simulation:
         chain_tether: float | None = None,
         chain_tether_release_n: float | None = None,
     ) -> Simulation:
-        """A model from a label volume (NIfTI-1 or NRRD) and its label table (JSON or
-        TOML), or a segmentation tool's label list (ITK-SNAP label description file, 3D
-        Slicer colour table) whose names are mapped onto known structures; without
-        ``labels``, a 3D Slicer segmentation's (``.seg.nrrd``) own segment names.
-        ``unmapped`` (``"error"``, ``"fat"`` or ``"ignore"``) says what to do with a name
-        none is known by."""
+        """A model from a label volume (NIfTI-1/-2 or NRRD; an oblique or reordered scan is
+        brought into the body frame) or a PNG stack (its folder or manifest), told apart
+        by content, and its label table (JSON or TOML), or a segmentation tool's label
+        list (ITK-SNAP label description file, 3D Slicer colour table) whose names are
+        mapped onto known structures; without ``labels``, a 3D Slicer segmentation's
+        (``.seg.nrrd``) own segment names. ``unmapped`` (``"error"``, ``"fat"`` or
+        ``"ignore"``) says what to do with a name none is known by; ``names`` is your own
+        names file (TOML: ``[map]`` name = structure, new muscles as
+        ``[structure.NAME]``). Each muscle the catalogue does not know is built from its
+        volume and length, with a ``UserWarning`` (see :attr:`warnings`)."""
+
+    @staticmethod
+    def from_file(path: _StrPath, labels: _StrPath | None = None, **kwargs: Any) -> Simulation:
+        """Any file myoslice reads, told apart by content: a scenario (as
+        :meth:`from_scenario`; it takes no other argument) or a label volume or PNG stack
+        (as :meth:`from_nifti`, with its keyword arguments)."""
 
     @staticmethod
     def from_scenario(path: _StrPath) -> Simulation:
@@ -260,6 +271,11 @@ class Simulation:
     def folded_elements(self) -> int:
         """Fat elements with a folded corner now (a corner Jacobian at or below zero,
         ParaView's test of a valid hexahedron); 0 without tissue."""
+
+    @property
+    def warnings(self) -> list[str]:
+        """What the build could not take from the muscle catalogue: one line per muscle
+        whose parameters came from its volume and length."""
 
     @property
     def guard_tally(self) -> _GuardTally:

@@ -4,17 +4,15 @@
 mod arrays;
 mod config;
 mod errors;
+mod render;
+mod sources;
 
 use std::path::PathBuf;
-use std::sync::OnceLock;
 
-use myoslice::label_names::Unmapped;
 use myoslice::muscle::MuscleCatalogue;
 use myoslice::prelude::*;
 use myoslice::simulation::{Layer, SimulationState};
-use myoslice_viewer::capture::{CaptureOptions, Offscreen};
-use myoslice_viewer::{CameraPreset, ColorMode, Gpu};
-use numpy::{IntoPyArray, PyArray1, PyArray3, PyReadonlyArray1};
+use numpy::{PyArray1, PyArray3, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -49,20 +47,7 @@ impl PyState {
 #[pyclass(name = "Simulation", module = "myoslice._myoslice")]
 struct PySimulation {
     sim: Simulation,
-    offscreen: Option<(u32, u32, Offscreen)>,
-}
-
-fn gpu(py: Python<'_>) -> PyResult<&'static Gpu> {
-    static GPU: OnceLock<Result<Gpu, String>> = OnceLock::new();
-    GPU.get_or_init(|| Gpu::headless().map_err(|e| e.to_string()))
-        .as_ref()
-        .map_err(|e| {
-            py_err(
-                py,
-                Kind::Renderer,
-                format!("the off-screen renderer is not available: {e}"),
-            )
-        })
+    offscreen: render::Target,
 }
 
 #[pymethods]
@@ -113,18 +98,21 @@ impl PySimulation {
         })
     }
 
-    /// A label volume (NIfTI-1 or NRRD) with its label table (JSON or TOML) or a
-    /// segmentation tool's label list (ITK-SNAP, 3D Slicer), whose names are mapped onto
-    /// known structures; without one, a 3D Slicer segmentation's own segment names.
-    /// `unmapped` ("error", "fat" or "ignore") says what to do with a name none is known by.
+    /// A label volume (NIfTI-1/-2 or NRRD) or a PNG stack (its folder or manifest), told
+    /// apart by content, with its label table (JSON or TOML) or a segmentation tool's
+    /// label list (ITK-SNAP, 3D Slicer), whose names are mapped onto known structures;
+    /// without one, a 3D Slicer segmentation's own segment names. `unmapped` ("error",
+    /// "fat" or "ignore") says what to do with a name none is known by; `names` is the
+    /// user's own names file (TOML).
     #[staticmethod]
-    #[pyo3(signature = (volume, labels = None, *, unmapped = "error", slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, tissue_iterations = None, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, chain_tether_release_n = None))]
+    #[pyo3(signature = (volume, labels = None, *, unmapped = "error", names = None, slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, tissue_iterations = None, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, chain_tether_release_n = None))]
     #[allow(clippy::too_many_arguments)]
     fn from_nifti(
         py: Python<'_>,
         volume: PathBuf,
         labels: Option<PathBuf>,
         unmapped: &str,
+        names: Option<PathBuf>,
         slice_step: usize,
         rays: usize,
         body_mass_kg: f64,
@@ -139,23 +127,7 @@ impl PySimulation {
         chain_tether: Option<f64>,
         chain_tether_release_n: Option<f64>,
     ) -> PyResult<Self> {
-        check_path(py, &volume, "volume")?;
-        if let Some(labels) = &labels {
-            check_path(py, labels, "label table")?;
-        }
-        let unmapped = match unmapped {
-            "error" => Unmapped::Error,
-            "fat" => Unmapped::Fat,
-            "ignore" => Unmapped::Ignore,
-            other => {
-                return Err(myoslice::Error::InvalidValue {
-                    name: "unmapped".into(),
-                    value: format!("'{other}'"),
-                    expected: "\"error\", \"fat\" or \"ignore\"".into(),
-                })
-                .or_py(py);
-            }
-        };
+        let mapping = sources::mapping(py, unmapped, names.as_deref())?;
         let c = ConfigArgs {
             body_mass_kg,
             height_m,
@@ -178,15 +150,45 @@ impl PySimulation {
             rays,
             ..BuildOptions::default()
         };
-        let sim = py
-            .detach(move || {
-                Simulation::from_segmentation(&volume, labels.as_deref(), unmapped, &build, c)
-            })
-            .or_py(py)?;
+        let sim = sources::simulation_from_file(py, volume, labels, mapping, build, c)?;
+        sources::warn(py, sim.warnings())?;
         Ok(Self {
             sim,
             offscreen: None,
         })
+    }
+
+    /// Any file myoslice reads, told apart by its content: a scenario (built as
+    /// `from_scenario`, which takes no other argument), or a label volume or PNG stack
+    /// (as `from_nifti`, with the same keyword arguments).
+    #[staticmethod]
+    #[pyo3(signature = (path, labels = None, **kwargs))]
+    fn from_file(
+        py: Python<'_>,
+        path: PathBuf,
+        labels: Option<PathBuf>,
+        kwargs: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<Py<Self>> {
+        let ty = py.get_type::<Self>();
+        if sources::is_scenario(py, &path)? {
+            let extra = kwargs.map_or(0, |k| k.len());
+            if labels.is_some() || extra > 0 {
+                return Err(py_err(
+                    py,
+                    Kind::Invalid,
+                    format!(
+                        "{} is a scenario, which brings its own model and settings: give it \
+                         alone",
+                        path.display()
+                    ),
+                ));
+            }
+            return Ok(ty.getattr("from_scenario")?.call1((path,))?.extract()?);
+        }
+        Ok(ty
+            .getattr("from_nifti")?
+            .call((path, labels), kwargs)?
+            .extract()?)
     }
 
     /// A scenario file (TOML): model, body, muscle model, excitation schedules.
@@ -476,6 +478,14 @@ impl PySimulation {
         self.sim.tissue_metrics().map_or(0, |m| m.inverted)
     }
 
+    /// What the build could not take from the muscle catalogue: one line per muscle
+    /// whose parameters came from its volume and length (also issued as Python
+    /// warnings by `from_file` and `from_nifti`).
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.sim.warnings().to_vec()
+    }
+
     /// How often the tissue's validity guard stepped in since the build: a dict of
     /// `updates` (tissue updates it moved fat in) and `vertices` (fat vertices it moved,
     /// summed); zeros without tissue. Part of a checkpoint.
@@ -561,57 +571,15 @@ impl PySimulation {
         color: &str,
         camera: &str,
     ) -> PyResult<Bound<'py, PyArray3<u8>>> {
-        let color_mode = ColorMode::parse(color).ok_or_else(|| {
-            py_err(
-                py,
-                Kind::Invalid,
-                format!("color = '{color}': expected 'area', 'degree' or 'none'"),
-            )
-        })?;
-        let cam = CameraPreset::parse(camera).ok_or_else(|| {
-            py_err(
-                py,
-                Kind::Invalid,
-                format!("camera = '{camera}': expected front, side, back, medial or oblique"),
-            )
-        })?;
-        if !(16..=8192).contains(&width) || !(16..=8192).contains(&height) {
-            return Err(py_err(
-                py,
-                Kind::Invalid,
-                format!("render size {width}x{height}: expected 16 to 8192 pixels each way"),
-            ));
-        }
-        let gpu = gpu(py)?;
-        let mut opts = CaptureOptions {
+        render::render(
+            py,
+            &self.sim,
+            &mut self.offscreen,
             width,
             height,
-            camera: cam,
-            legend: false,
-            ..CaptureOptions::default()
-        };
-        opts.scene.color_mode = color_mode;
-        if self
-            .offscreen
-            .as_ref()
-            .is_none_or(|(w, h, _)| (*w, *h) != (width, height))
-        {
-            self.offscreen = Some((width, height, Offscreen::new(gpu, width, height)));
-        }
-        let Some((_, _, off)) = self.offscreen.as_mut() else {
-            unreachable!()
-        };
-        let sim = &self.sim;
-        let rgba = py
-            .detach(|| off.render(gpu, sim, &opts).map_err(|e| e.to_string()))
-            .map_err(|e| py_err(py, Kind::Renderer, e))?;
-        let rgb: Vec<u8> = rgba
-            .chunks_exact(4)
-            .flat_map(|p| [p[0], p[1], p[2]])
-            .collect();
-        let arr = numpy::ndarray::Array3::from_shape_vec((height as usize, width as usize, 3), rgb)
-            .map_err(|e| py_err(py, Kind::Renderer, e.to_string()))?;
-        Ok(arr.into_pyarray(py))
+            color,
+            camera,
+        )
     }
 
     fn __repr__(&self) -> String {

@@ -266,24 +266,38 @@ def test_bad_chain_tether_is_named() -> None:
 VISIBLE_HUMAN = Path(__file__).resolve().parents[3] / "shared" / "data" / "visible-human"
 
 
-def test_a_segmentation_tools_label_list_builds_the_leg_and_unknown_names_are_refused(tmp_path: Path) -> None:
-    """An ITK-SNAP label file with people's names builds the same leg as our own label
-    table; a label no structure is known by is refused unless asked otherwise."""
+def _visible_human() -> tuple[Path, Path]:
+    """The Visible Human volume and label table; never a silent pass when absent."""
     volume = VISIBLE_HUMAN / "vhf_left_leg_labels.nii.gz"
-    table = VISIBLE_HUMAN / "vhf_left_leg_labels.json"
     if not volume.exists():
-        # Never a silent pass: the data are expected beside the project.
         if os.environ.get("MYOSLICE_ALLOW_MISSING_DATA") != "1":
             pytest.fail(f"{volume} is absent (set MYOSLICE_ALLOW_MISSING_DATA=1 to skip on purpose)")
         pytest.skip(f"{volume} is absent")
+    return volume, VISIBLE_HUMAN / "vhf_left_leg_labels.json"
+
+
+def _itk_snap(table: Path, path: Path, rename: Callable[[str], str], extra: str = "") -> Path:
+    """The table's labels as an ITK-SNAP label description file, each name as `rename`
+    says (background and fat by their usual names)."""
     labels = json.loads(table.read_text())["labels"]
     lines = ["# ITK-SnAP Label Description File"]
     for key, rec in sorted(labels.items(), key=lambda kv: int(kv[0])):
-        name = {"background": "Clear Label", "fat": "Subcutaneous fat"}.get(rec["name"], "Left " + rec["name"].replace("_", " "))
+        name = {"background": "Clear Label", "fat": "Subcutaneous fat"}.get(rec["name"]) or rename(rec["name"])
         lines.append(f'{key} 10 20 30 1 1 1 "{name}"')
-    lines.append('99 1 1 1 1 1 1 "Popliteal artery"')
-    itk = tmp_path / "leg-labels.txt"
-    itk.write_text("\n".join(lines) + "\n")
+    path.write_text("\n".join(lines) + "\n" + extra)
+    return path
+
+
+def test_a_segmentation_tools_label_list_builds_the_leg_and_unknown_names_are_refused(tmp_path: Path) -> None:
+    """An ITK-SNAP label file with people's names builds the same leg as our own label
+    table; a label no structure is known by is refused unless asked otherwise."""
+    volume, table = _visible_human()
+    itk = _itk_snap(
+        table,
+        tmp_path / "leg-labels.txt",
+        lambda n: "Left " + n.replace("_", " "),
+        '99 1 1 1 1 1 1 "Popliteal artery"\n',
+    )
     with pytest.raises(MyoSliceError) as info:
         Simulation.from_nifti(volume, itk, tissue=False)
     assert "label 99 'Popliteal artery'" in str(info.value)
@@ -297,3 +311,38 @@ def test_a_segmentation_tools_label_list_builds_the_leg_and_unknown_names_are_re
     theirs = Simulation.from_nifti(volume, itk, unmapped="fat", tissue=False)
     assert theirs.muscle_names == ours.muscle_names
     assert theirs.n_fat_elements == ours.n_fat_elements
+
+
+def test_from_file_reads_by_content_with_the_users_own_names(tmp_path: Path) -> None:
+    """`from_file` tells a scenario from a volume by content; a names file maps the
+    user's names (winning over the synonyms) and adds a muscle the catalogue does not
+    know, which is built from its volume and length with a warning."""
+    volume, table = _visible_human()
+    renamed = {"gracilis": "GRA-x", "sartorius": "Strap muscle"}
+    itk = _itk_snap(table, tmp_path / "leg-labels.txt", lambda n: renamed.get(n, n))
+    names = tmp_path / "my-names.toml"
+    names.write_text(
+        '[map]\n"GRA-x" = "gracilis"\n\n'
+        '[structure.strap_muscle]\nkind = "muscle"\norigin = "hip_bone"\ninsertion = "tibia"\nnames = ["Strap muscle"]\n'
+    )
+    with pytest.raises(MyoSliceError) as info:
+        Simulation.from_file(volume, itk, tissue=False)
+    assert "'GRA-x'" in str(info.value) and "'Strap muscle'" in str(info.value)
+    with pytest.warns(UserWarning, match="muscle 'strap_muscle' has no entry in the muscle catalogue"):
+        sim = Simulation.from_file(volume, itk, names=names, tissue=False)
+    assert "gracilis" in sim.muscle_names and "strap_muscle" in sim.muscle_names
+    assert "sartorius" not in sim.muscle_names
+    assert [w.split("'")[1] for w in sim.warnings] == ["strap_muscle"]
+    with pytest.raises(ModelFileError, match="names file"):
+        Simulation.from_file(volume, itk, names=tmp_path / "absent.toml")
+    bad = tmp_path / "bad-names.toml"
+    bad.write_text('[map]\n"GRA-x" = "kidney"\n')
+    with pytest.raises(ModelFileError, match='map."GRA-x" = "kidney"'):
+        Simulation.from_file(volume, itk, names=bad)
+    # A scenario, whatever its name, is a scenario; it takes no other argument.
+    scenario = tmp_path / "knee.cfg"
+    scenario.write_text('[model]\nsource = "phantom"\n[simulation]\nduration_s = 0.01\n[tissue]\nenabled = false\n')
+    sc = Simulation.from_file(scenario)
+    assert sc.warnings == [] and sc.n_fat_elements > 0
+    with pytest.raises(InvalidInputError, match="scenario"):
+        Simulation.from_file(scenario, tissue=False)

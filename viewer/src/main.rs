@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{Context, Result, anyhow};
+use anyhow::{Context, Result, anyhow, bail};
 use clap::Parser;
 use myoslice::prelude::*;
 use myoslice_viewer::camera::CameraPreset;
@@ -32,12 +32,19 @@ struct Args {
     /// Scenario file (model, excitations).
     #[arg(long, conflicts_with_all = ["volume", "labels"])]
     scenario: Option<PathBuf>,
-    /// NIfTI label volume.
-    #[arg(long, requires = "labels")]
+    /// Label volume: NIfTI or NRRD; a 3D Slicer segmentation (.seg.nrrd) names its own
+    /// labels.
+    #[arg(long)]
     volume: Option<PathBuf>,
-    /// Label table for --volume.
+    /// Label table, ITK-SNAP label file or Slicer colour table for --volume.
     #[arg(long, requires = "volume")]
     labels: Option<PathBuf>,
+    /// Your own label names (TOML: `[map]` name = structure) for --volume.
+    #[arg(long, requires = "volume")]
+    names: Option<PathBuf>,
+    /// Label names no structure is known by: error, fat or ignore.
+    #[arg(long, default_value = "error", requires = "volume")]
+    unmapped: String,
     /// Simulated time before the capture (s).
     #[arg(long, default_value_t = 0.0)]
     time: f64,
@@ -77,19 +84,31 @@ struct Args {
     meta: Option<PathBuf>,
 }
 
+/// The model the command line names.
+fn source(args: &Args) -> Result<ModelSource> {
+    let Some(volume) = &args.volume else {
+        return Ok(ModelSource::Phantom);
+    };
+    let unmapped = match args.unmapped.as_str() {
+        "error" => Unmapped::Error,
+        "fat" => Unmapped::Fat,
+        "ignore" => Unmapped::Ignore,
+        other => bail!("unknown --unmapped '{other}': use error, fat or ignore"),
+    };
+    Ok(ModelSource::Volume {
+        volume: volume.clone(),
+        labels: args.labels.clone(),
+        names: args.names.clone(),
+        unmapped,
+    })
+}
+
 fn build(args: &Args) -> Result<Simulation> {
     if let Some(s) = &args.scenario {
         let sc = Scenario::from_path(s)?;
         return sc.build().map_err(|e| anyhow!("{e}"));
     }
-    let source = match (&args.volume, &args.labels) {
-        (Some(v), Some(l)) => ModelSource::Nifti {
-            volume: v.clone(),
-            labels: l.clone(),
-        },
-        _ => ModelSource::Phantom,
-    };
-    let mut sim = source.load(SimulationConfig::default())?;
+    let mut sim = source(args)?.load(SimulationConfig::default())?;
     let preset = Preset::parse(&args.preset).ok_or_else(|| {
         anyhow!(
             "unknown --preset '{}': use relax, flexion, extension or cocontraction",
@@ -207,17 +226,10 @@ fn main() -> ExitCode {
     let result = if offscreen {
         capture(&args)
     } else {
-        let source = match (&args.volume, &args.labels) {
-            (Some(v), Some(l)) => ModelSource::Nifti {
-                volume: v.clone(),
-                labels: l.clone(),
-            },
-            _ => ModelSource::Phantom,
-        };
         let opts = app::RunOptions {
             exit_after_frames: args.exit_after_frames,
         };
-        app::run(source, args.scenario.clone(), opts).map(|stats| {
+        source(&args).and_then(|source| app::run(source, args.scenario.clone(), opts)).map(|stats| {
             if args.exit_after_frames.is_some() {
                 println!(
                     "window: {} frames; first {:.0} ms; then mean {:.1} ms (simulating {:.1} ms), slowest {:.1} ms",

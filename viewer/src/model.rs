@@ -1,4 +1,5 @@
-//! Which model to load: the phantom, a NIfTI volume with its label table, or a scenario.
+//! Which model to load: the phantom, a label volume (NIfTI, NRRD, Slicer segmentation)
+//! with what its labels mean, or a scenario.
 
 use std::path::PathBuf;
 
@@ -11,12 +12,17 @@ pub enum ModelSource {
     /// The built-in phantom.
     #[default]
     Phantom,
-    /// A NIfTI label volume and its label table.
-    Nifti {
+    /// A label volume (NIfTI or NRRD) and its label table or a tool's label list; a 3D
+    /// Slicer segmentation names its own labels.
+    Volume {
         /// Volume path.
         volume: PathBuf,
-        /// Label table path.
-        labels: PathBuf,
+        /// Label table or label list (None: the segmentation's own names).
+        labels: Option<PathBuf>,
+        /// The user's names file (TOML).
+        names: Option<PathBuf>,
+        /// What becomes of label names no structure is known by.
+        unmapped: Unmapped,
     },
 }
 
@@ -25,15 +31,34 @@ impl ModelSource {
     pub fn load(&self, config: SimulationConfig) -> Result<Simulation> {
         match self {
             ModelSource::Phantom => Simulation::phantom(config).context("building the phantom"),
-            ModelSource::Nifti { volume, labels } => {
-                if !volume.exists() {
-                    bail!("volume file {} does not exist", volume.display());
+            ModelSource::Volume {
+                volume,
+                labels,
+                names,
+                unmapped,
+            } => {
+                for (what, p) in [("volume", Some(volume)), ("label file", labels.as_ref())]
+                    .into_iter()
+                    .chain([("names file", names.as_ref())])
+                {
+                    if let Some(p) = p
+                        && !p.exists()
+                    {
+                        bail!("{what} {} does not exist", p.display());
+                    }
                 }
-                if !labels.exists() {
-                    bail!("label table {} does not exist", labels.display());
+                let mut mapping = LabelMapping::new(*unmapped);
+                if let Some(n) = names {
+                    mapping = mapping.with_names_file(n)?;
                 }
-                Simulation::from_nifti(volume, labels, &BuildOptions::default(), config)
-                    .with_context(|| format!("building the model from {}", volume.display()))
+                Simulation::from_segmentation(
+                    volume,
+                    labels.as_deref(),
+                    mapping,
+                    &BuildOptions::default(),
+                    config,
+                )
+                .with_context(|| format!("building the model from {}", volume.display()))
             }
         }
     }
@@ -42,7 +67,7 @@ impl ModelSource {
     pub fn describe(&self) -> String {
         match self {
             ModelSource::Phantom => "built-in phantom".into(),
-            ModelSource::Nifti { volume, .. } => volume.display().to_string(),
+            ModelSource::Volume { volume, .. } => volume.display().to_string(),
         }
     }
 }

@@ -5,6 +5,7 @@
 use std::collections::VecDeque;
 
 use myoslice::Simulation;
+use myoslice::label_names::Unmapped;
 use myoslice::muscle::MuscleGroup;
 
 use crate::camera::CameraPreset;
@@ -308,6 +309,15 @@ impl UiState {
                 ));
                 ui.end_row();
             }
+            if !sim.warnings().is_empty() {
+                ui.label("warnings");
+                ui.label(format!(
+                    "{} muscles built from the default rule",
+                    sim.warnings().len()
+                ))
+                .on_hover_text(sim.warnings().join("\n"));
+                ui.end_row();
+            }
         });
     }
 
@@ -518,10 +528,13 @@ impl UiState {
                     ui.text_edit_singleline(&mut self.open_labels);
                 });
                 ui.horizontal(|ui| {
-                    if ui.button("Load NIfTI").clicked() {
-                        actions.push(UiAction::Load(ModelSource::Nifti {
+                    if ui.button("Load volume").clicked() {
+                        let labels = self.open_labels.trim();
+                        actions.push(UiAction::Load(ModelSource::Volume {
                             volume: self.open_volume.trim().into(),
-                            labels: self.open_labels.trim().into(),
+                            labels: (!labels.is_empty()).then(|| labels.into()),
+                            names: None,
+                            unmapped: Unmapped::Error,
                         }));
                     }
                     if ui.button("Phantom").clicked() {

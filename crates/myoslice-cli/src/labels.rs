@@ -2,13 +2,14 @@
 
 use std::fmt::Write as _;
 use std::io::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use clap::{Args, ValueEnum};
 use myoslice::LabelTable;
 use myoslice::io::{is_nrrd, parse_nrrd};
-use myoslice::label_names::{AnatomyNames, Unmapped, map_labels};
+use myoslice::label_mapping::LabelMapping;
+use myoslice::label_names::{Unmapped, map_labels};
 
 /// What to do with a label name no structure is known by.
 #[derive(Debug, Clone, Copy, Default, ValueEnum)]
@@ -40,6 +41,19 @@ pub(crate) struct LabelsArgs {
     /// Label names no structure is known by: an error, or fat, or background.
     #[arg(long, value_enum, default_value_t = UnmappedArg::Error)]
     unmapped: UnmappedArg,
+    /// Your own names (TOML): `[map]` label name = structure, and muscles myoslice does
+    /// not know as `[structure.NAME]`.
+    #[arg(long)]
+    names: Option<PathBuf>,
+}
+
+/// The mapping `--unmapped` and `--names` ask for.
+pub(crate) fn mapping(unmapped: UnmappedArg, names: Option<&Path>) -> Result<LabelMapping> {
+    let m = LabelMapping::new(unmapped.into());
+    Ok(match names {
+        Some(p) => m.with_names_file(p)?,
+        None => m,
+    })
 }
 
 /// Prints each label, the name the file gives it and what it becomes; lists the names
@@ -47,9 +61,10 @@ pub(crate) struct LabelsArgs {
 pub(crate) fn run(a: &LabelsArgs) -> Result<()> {
     // Read once taking unknown names as asked, or as fat where that would be an error, to
     // show every label; then as asked.
+    let asked = mapping(a.unmapped, a.names.as_deref())?;
     let shown = match a.unmapped {
-        UnmappedArg::Error => Unmapped::Fat,
-        other => other.into(),
+        UnmappedArg::Error => mapping(UnmappedArg::Fat, a.names.as_deref())?,
+        _ => asked.clone(),
     };
     let mut out = String::new();
     // Read once: a segmentation is parsed from these bytes, a label file as text.
@@ -69,9 +84,8 @@ pub(crate) fn run(a: &LabelsArgs) -> Result<()> {
             if let Some(rule) = &v.merge {
                 writeln!(out, "{rule}")?;
             }
-            let names = AnatomyNames::builtin()?;
             let origin = a.file.display().to_string();
-            let (table, how) = map_labels(&list, names, shown, &origin)?;
+            let (table, how) = map_labels(&list, shown.names()?, shown.unmapped(), &origin)?;
             (table, Some(how), Some((list, origin)))
         }
         None => {
@@ -126,10 +140,10 @@ pub(crate) fn run(a: &LabelsArgs) -> Result<()> {
     // As it would be read with the option given (an error for unknown names by default).
     match segments {
         Some((list, origin)) => {
-            map_labels(&list, AnatomyNames::builtin()?, a.unmapped.into(), &origin)?;
+            map_labels(&list, asked.names()?, asked.unmapped(), &origin)?;
         }
         None => {
-            LabelTable::from_path_with(&a.file, a.unmapped.into())?;
+            LabelTable::from_path_with(&a.file, asked)?;
         }
     }
     Ok(())

@@ -145,6 +145,9 @@ struct ModelArgs {
     /// Label names no structure is known by: an error, or fat, or background.
     #[arg(long, value_enum, default_value_t = labels::UnmappedArg::Error)]
     unmapped: labels::UnmappedArg,
+    /// Your own label names (TOML, see `myoslice labels --help`).
+    #[arg(long, requires = "volume")]
+    names: Option<PathBuf>,
     /// Keep every K-th slice.
     #[arg(long, default_value_t = 5)]
     slice_step: usize,
@@ -171,8 +174,8 @@ struct BuildArgs {
 fn load(m: &ModelArgs) -> Result<(LabelVolume, LabelTable, String)> {
     match &m.volume {
         Some(v) => {
-            let (vol, table) =
-                myoslice::io::read_segmentation(v, m.labels.as_deref(), m.unmapped.into())?;
+            let mapping = labels::mapping(m.unmapped, m.names.as_deref())?;
+            let (vol, table) = myoslice::io::read_input(v, m.labels.as_deref(), mapping)?;
             Ok((vol, table, v.display().to_string()))
         }
         None => {
@@ -211,6 +214,20 @@ fn build(args: &BuildArgs) -> Result<()> {
     let t1 = Instant::now();
     let lattice = Lattice::build(&volume, &table, &opts)?;
     let build_time = t1.elapsed().as_secs_f64();
+    let catalogue = myoslice::muscle::MuscleCatalogue::default();
+    for m in lattice
+        .muscles
+        .iter()
+        .filter(|m| !catalogue.muscles.contains_key(&m.name))
+    {
+        pb.suspend(|| {
+            eprintln!(
+                "warning: muscle '{}' has no entry in the muscle catalogue: its parameters \
+                 will come from its volume and length",
+                m.name
+            )
+        });
+    }
     pb.set_message("measuring volumes and coverage");
     let mut report = BuildReport::measure(&volume, &lattice, &source);
     pb.set_message("checking invariants");
@@ -277,6 +294,9 @@ fn run_scenario(a: &RunArgs) -> Result<()> {
     }
     let t0 = Instant::now();
     let mut sim = sc.build()?;
+    for w in sim.warnings() {
+        eprintln!("warning: {w}");
+    }
     let outputs = RunOutputs {
         vtu: sc.output.vtu,
         glb: sc.output.glb,

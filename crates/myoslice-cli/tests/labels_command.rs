@@ -1,5 +1,6 @@
 //! `myoslice labels FILE`: every label of a segmentation tool's list with the structure
-//! it maps to; unknown names listed, and an error unless taken as fat or background.
+//! it maps to; unknown names listed, and an error unless taken as fat or background or
+//! named in the user's names file.
 
 use std::process::{Command, Output};
 
@@ -47,6 +48,29 @@ fn the_labels_command_shows_each_mapping_and_refuses_unknown_names_unless_asked(
             String::from_utf8_lossy(&out.stderr)
         );
     }
+    // A names file says what the nerve is, and renames the hamstring.
+    let names = dir.join("names.toml");
+    std::fs::write(
+        &names,
+        "[map]\n\"Sciatic nerve\" = \"fat\"\n\"Biceps femoris long head\" = \"semitendinosus\"\n",
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let out = labels(&file, &["--names", &names.display().to_string()]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    assert!(
+        stdout.contains("semitendinosus") && !stdout.contains("biceps_femoris_long"),
+        "{stdout}"
+    );
+    assert!(!stdout.contains("not known"), "{stdout}");
+    std::fs::write(&names, "[map]\n\"Sciatic nerve\" = \"nervus\"\n")
+        .unwrap_or_else(|e| panic!("{e}"));
+    let out = labels(&file, &["--names", &names.display().to_string()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("map.\"Sciatic nerve\" = \"nervus\""),
+        "{stderr}"
+    );
     let out = labels(&dir.join("absent.txt"), &[]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("absent.txt"));
     std::fs::remove_dir_all(dir).unwrap_or_else(|e| panic!("{e}"));

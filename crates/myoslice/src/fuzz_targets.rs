@@ -8,11 +8,12 @@ use std::path::Path;
 
 use crate::label_names::{AnatomyNames, Unmapped, map_labels};
 
-/// A NIfTI-1 file (gzip or not).
+/// A NIfTI-1 or NIfTI-2 file (gzip or not).
 pub fn nifti(data: &[u8]) -> bool {
     crate::io::parse_nifti(data, Path::new("fuzz.nii")).is_ok_and(|v| {
-        // What was accepted can be reordered for the builder.
-        let _ = v.canonical();
+        // What was accepted can be brought into the builder's frame (reordered or
+        // resampled within its cap).
+        let _ = v.in_frame();
         true
     })
 }
@@ -29,7 +30,7 @@ pub fn nrrd(data: &[u8]) -> bool {
         return false;
     }
     crate::io::parse_nrrd(data, Path::new("fuzz.nrrd")).is_ok_and(|v| {
-        let _ = v.volume.canonical();
+        let _ = v.volume.in_frame();
         true
     })
 }
@@ -72,15 +73,26 @@ pub fn png_slice(data: &[u8]) -> bool {
     crate::io::decode_png_labels(data, Path::new("fuzz.png"), &colors).is_ok()
 }
 
+/// A user's names file (`[map]`, `[structure.NAME]`) over the built-in synonyms.
+pub fn names(data: &[u8]) -> bool {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return false;
+    };
+    crate::label_mapping::LabelMapping::new(Unmapped::Error)
+        .with_names_str(text, "fuzz.toml")
+        .is_ok()
+}
+
 /// A target: whether it accepted the bytes.
 pub type Target = fn(&[u8]) -> bool;
 
 /// Every target by name, for the corpus replay.
-pub const TARGETS: [(&str, Target); 6] = [
+pub const TARGETS: [(&str, Target); 7] = [
     ("nifti", nifti),
     ("nrrd", nrrd),
     ("label_list", label_list),
     ("label_table", label_table),
     ("scenario", scenario),
     ("png_slice", png_slice),
+    ("names", names),
 ];

@@ -106,36 +106,63 @@ impl AnatomyNames {
     pub fn from_toml_str(text: &str, origin: &str) -> Result<Self> {
         let raw: RawNames =
             toml::from_str(text).map_err(|e| Error::parse(origin, e.to_string()))?;
-        let mut structures = Vec::with_capacity(raw.structure.len());
-        let mut index = BTreeMap::new();
+        let mut table = Self {
+            structures: Vec::with_capacity(raw.structure.len()),
+            index: BTreeMap::new(),
+        };
         for (name, mut s) in raw.structure {
             s.name = name;
-            let i = structures.len();
-            for n in std::iter::once(&s.name).chain(&s.names) {
-                let key = normalise(n);
-                if key.is_empty() {
-                    return Err(Error::parse(
-                        origin,
-                        format!("'{}': the name '{n}' has no words left to compare", s.name),
-                    ));
-                }
-                if let Some(&j) = index.get(&key)
-                    && j != i
-                {
-                    let other: &Structure = &structures[j];
-                    return Err(Error::parse(
-                        origin,
-                        format!(
-                            "'{n}' of '{}' reads as '{key}', a name of '{}' too",
-                            s.name, other.name
-                        ),
-                    ));
-                }
-                index.insert(key, i);
-            }
-            structures.push(s);
+            table.add_structure(s, origin)?;
         }
-        Ok(Self { structures, index })
+        Ok(table)
+    }
+
+    /// Adds a structure under its canonical name and its synonyms; a name that
+    /// normalises like another structure's is an error.
+    pub(crate) fn add_structure(&mut self, s: Structure, origin: &str) -> Result<usize> {
+        let i = self.structures.len();
+        let mut keys = Vec::with_capacity(s.names.len() + 1);
+        for n in std::iter::once(&s.name).chain(&s.names) {
+            let key = normalise(n);
+            if key.is_empty() {
+                return Err(Error::parse(
+                    origin,
+                    format!("'{}': the name '{n}' has no words left to compare", s.name),
+                ));
+            }
+            if let Some(&j) = self.index.get(&key) {
+                let other = &self.structures[j];
+                return Err(Error::parse(
+                    origin,
+                    format!(
+                        "'{n}' of '{}' reads as '{key}', a name of '{}' too",
+                        s.name, other.name
+                    ),
+                ));
+            }
+            keys.push(key);
+        }
+        for key in keys {
+            self.index.insert(key, i);
+        }
+        self.structures.push(s);
+        Ok(i)
+    }
+
+    /// Makes `name` read as structure `i`, whatever it read as before (an explicit
+    /// mapping wins over the synonym table). False when the name has no words to compare.
+    pub(crate) fn set_alias(&mut self, name: &str, i: usize) -> bool {
+        let key = normalise(name);
+        if key.is_empty() || i >= self.structures.len() {
+            return false;
+        }
+        self.index.insert(key, i);
+        true
+    }
+
+    /// Index of the structure a name stands for.
+    pub(crate) fn position(&self, name: &str) -> Option<usize> {
+        self.index.get(&normalise(name)).copied()
     }
 
     /// The structure a label name stands for, if the table knows it.

@@ -14,7 +14,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{Error, Result};
 use crate::io::{parse_label_list, sniff_label_list};
-use crate::label_names::{AnatomyNames, MappedLabel, Unmapped, map_labels};
+use crate::label_mapping::LabelMapping;
+use crate::label_names::{MappedLabel, Unmapped, map_labels};
 
 /// What a label stands for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -164,7 +165,11 @@ impl LabelTable {
     }
 
     /// [`Self::from_path`], taking a tool's unknown label names as `unmapped` says.
-    pub fn from_path_with(path: impl AsRef<Path>, unmapped: Unmapped) -> Result<Self> {
+    /// (`unmapped` may be a [`LabelMapping`] that carries the user's own names too).
+    pub fn from_path_with(
+        path: impl AsRef<Path>,
+        unmapped: impl Into<LabelMapping>,
+    ) -> Result<Self> {
         Ok(Self::read_mapped(path, unmapped)?.0)
     }
 
@@ -172,8 +177,9 @@ impl LabelTable {
     /// our own formats, whose names are ours already).
     pub fn read_mapped(
         path: impl AsRef<Path>,
-        unmapped: Unmapped,
+        mapping: impl Into<LabelMapping>,
     ) -> Result<(Self, Option<Vec<MappedLabel>>)> {
+        let mapping = mapping.into();
         let path = path.as_ref();
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
         let origin = path.display().to_string();
@@ -188,7 +194,7 @@ impl LabelTable {
             return Ok((Self::from_toml_str(&text, &origin)?, None));
         }
         let list = parse_label_list(&text, &origin)?;
-        let (table, how) = map_labels(&list, AnatomyNames::builtin()?, unmapped, &origin)?;
+        let (table, how) = map_labels(&list, mapping.names()?, mapping.unmapped(), &origin)?;
         Ok((table, Some(how)))
     }
 

@@ -19,6 +19,7 @@ pub mod export;
 pub mod fuzz_targets;
 pub mod geometry;
 pub mod io;
+pub mod label_mapping;
 pub mod label_names;
 pub mod label_table;
 pub mod label_volume;
@@ -45,6 +46,7 @@ pub use slices::SliceReduction;
 pub mod prelude {
     pub use crate::error::{Error, Result};
     pub use crate::io::{read_nifti, read_png_stack};
+    pub use crate::label_mapping::LabelMapping;
     pub use crate::label_names::Unmapped;
     pub use crate::label_table::{LabelTable, TissueKind};
     pub use crate::label_volume::LabelVolume;

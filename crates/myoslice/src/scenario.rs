@@ -2,8 +2,11 @@
 //!
 //! ```toml
 //! [model]
-//! source = "phantom"          # or "nifti", with volume = "...", labels = "..." (relative
-//!                             # to this file)
+//! source = "phantom"          # or "nifti": volume = "..." (NIfTI or NRRD) with labels =
+//!                             # "..." (label table or a tool's label list; not for a
+//!                             # Slicer .seg.nrrd), optional names = "..." (your names, TOML)
+//!                             # and unmapped = "error" | "fat" | "ignore"; paths relative
+//!                             # to this file
 //! slice_step = 5              # keep every k-th slice (default 5)
 //! rays = 48                   # rays per polygon (default 48)
 //!
@@ -53,10 +56,16 @@ pub struct ModelSection {
     /// `phantom` or `nifti`.
     #[serde(default = "default_source")]
     pub source: String,
-    /// NIfTI volume (for `nifti`), relative to the scenario file.
+    /// Label volume, NIfTI or NRRD (for `nifti`), relative to the scenario file.
     pub volume: Option<PathBuf>,
-    /// Label table (for `nifti`).
+    /// Label table or a tool's label list (for `nifti`; none for a 3D Slicer
+    /// segmentation, which names its labels).
     pub labels: Option<PathBuf>,
+    /// The user's names file (TOML, see [`crate::label_mapping`]).
+    pub names: Option<PathBuf>,
+    /// What becomes of a label name no structure is known by: `error` (default), `fat`
+    /// or `ignore`.
+    pub unmapped: Option<String>,
     /// Keep every k-th slice.
     #[serde(default = "default_step")]
     pub slice_step: usize,
@@ -81,6 +90,8 @@ impl Default for ModelSection {
             source: default_source(),
             volume: None,
             labels: None,
+            names: None,
+            unmapped: None,
             slice_step: 5,
             rays: 48,
         }
@@ -250,24 +261,36 @@ impl Scenario {
         match raw.model.source.as_str() {
             "phantom" => {}
             "nifti" => {
-                for (k, v) in [
-                    ("model.volume", &raw.model.volume),
-                    ("model.labels", &raw.model.labels),
-                ] {
-                    let Some(p) = v else {
-                        return Err(err(format!(
-                            "{k} is required when model.source = \"nifti\""
-                        )));
-                    };
+                let Some(volume) = &raw.model.volume else {
+                    return Err(err(
+                        "model.volume is required when model.source = \"nifti\"".into(),
+                    ));
+                };
+                for (k, p) in [
+                    ("volume", Some(volume)),
+                    ("labels", raw.model.labels.as_ref()),
+                ]
+                .into_iter()
+                .chain([("names", raw.model.names.as_ref())])
+                {
+                    let Some(p) = p else { continue };
                     let full = resolve(path, p);
                     if !full.exists() {
                         return Err(err(format!(
-                            "{k} = {}{}: file not found ({})",
+                            "model.{k} = {}{}: file not found ({})",
                             p.display(),
-                            line_of(k.trim_start_matches("model.")),
+                            line_of(k),
                             full.display()
                         )));
                     }
+                }
+                if let Some(u) = &raw.model.unmapped
+                    && parse_unmapped(u).is_none()
+                {
+                    return Err(err(format!(
+                        "model.unmapped = \"{u}\"{}: expected \"error\", \"fat\" or \"ignore\"",
+                        line_of("unmapped")
+                    )));
                 }
             }
             other => {
@@ -339,11 +362,24 @@ impl Scenario {
                     &self.path,
                     self.model.volume.as_deref().unwrap_or(Path::new("")),
                 );
-                let l = resolve(
-                    &self.path,
-                    self.model.labels.as_deref().unwrap_or(Path::new("")),
-                );
-                Simulation::from_nifti(v, l, &self.build_options(), config)?
+                let l = self.model.labels.as_deref().map(|l| resolve(&self.path, l));
+                let unmapped = self
+                    .model
+                    .unmapped
+                    .as_deref()
+                    .and_then(parse_unmapped)
+                    .unwrap_or_default();
+                let mut mapping = crate::label_mapping::LabelMapping::new(unmapped);
+                if let Some(n) = &self.model.names {
+                    mapping = mapping.with_names_file(resolve(&self.path, n))?;
+                }
+                Simulation::from_segmentation(
+                    v,
+                    l.as_deref(),
+                    mapping,
+                    &self.build_options(),
+                    config,
+                )?
             }
             _ => {
                 let (volume, table) = crate::phantom::Phantom::default().generate()?;
@@ -417,6 +453,16 @@ pub fn group_members(sim: &Simulation, name: &str) -> Vec<String> {
         "all" => pick(&|_| true),
         n => pick(&|m| m.name == n),
     }
+}
+
+fn parse_unmapped(s: &str) -> Option<crate::label_names::Unmapped> {
+    use crate::label_names::Unmapped;
+    Some(match s {
+        "error" => Unmapped::Error,
+        "fat" => Unmapped::Fat,
+        "ignore" => Unmapped::Ignore,
+        _ => return None,
+    })
 }
 
 fn resolve(scenario: &Path, p: &Path) -> PathBuf {

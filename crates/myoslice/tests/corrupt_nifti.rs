@@ -49,10 +49,7 @@ fn a_header_claiming_a_trillion_voxels_is_refused_without_reading_them() {
     // 32767³ uint8 voxels: 3.5 × 10¹³ bytes.
     let b = with_dims(valid(), [i16::MAX; 3]);
     let e = parse(&b).unwrap_err().to_string();
-    assert!(
-        e.contains("truncated") && e.contains("hostile.nii.gz"),
-        "{e}"
-    );
+    assert!(e.contains("cap") && e.contains("hostile.nii.gz"), "{e}");
     let e = parse(&gzip(&b)).unwrap_err().to_string();
     assert!(
         e.contains("cap") && e.contains(&MAX_VOLUME_BYTES.to_string()),

@@ -67,6 +67,9 @@ pub struct RunSummary {
     /// Of the wall time, the part spent on the tissue updates inside `step` (s); the
     /// updates for output frames are not in it.
     pub tissue_wall_time_s: f64,
+    /// What the model's build could not take from the catalogue
+    /// ([`Simulation::warnings`]).
+    pub warnings: Vec<String>,
 }
 
 /// An open run folder.
@@ -127,6 +130,7 @@ impl RunWriter {
                 realtime_factor: 0.0,
                 muscles_wall_time_s: 0.0,
                 tissue_wall_time_s: 0.0,
+                warnings: sim.warnings().to_vec(),
             },
         };
         w.row(sim)?;

@@ -1,19 +1,22 @@
 //! Readers and writers of label volumes (NIfTI-1, NRRD, PNG stacks), and of the label
 //! lists of segmentation tools.
 
+pub mod input_kind;
 pub mod label_lists;
 pub mod nifti;
 pub mod nrrd;
 pub mod png_stack;
 
+pub use input_kind::InputKind;
 pub use label_lists::{LabelListFormat, LabelNames, parse_label_list, sniff_label_list};
 pub use nifti::{MAX_VOLUME_BYTES, encode_nifti, parse_nifti, read_nifti, write_nifti};
 pub use nrrd::{NrrdVolume, is_nrrd, parse_nrrd, read_nrrd};
 pub use png_stack::{decode_png_labels, read_png_stack, write_png_labels};
 
-/// Reads a label volume, NIfTI-1 or NRRD (told apart by content), in the order the lattice
-/// builder slices it ([`crate::LabelVolume::canonical`]: a scan saved in sagittal or
-/// coronal slices, or in a left-posterior-superior frame, is reordered voxel for voxel),
+/// Reads a label volume, NIfTI-1/-2 or NRRD (told apart by content), in the body frame
+/// the lattice builder slices in ([`crate::LabelVolume::in_frame`]: a scan saved in
+/// sagittal or coronal slices, or in a left-posterior-superior frame, is reordered voxel
+/// for voxel; an oblique one is resampled),
 /// with the label names the file itself carries (a 3D Slicer segmentation's segments;
 /// None otherwise).
 pub fn read_label_volume(
@@ -23,16 +26,17 @@ pub fn read_label_volume(
     let raw = std::fs::read(path).map_err(|e| crate::Error::io(path, e))?;
     if is_nrrd(&raw) {
         let v = parse_nrrd(&raw, path)?;
-        Ok((v.volume.canonical(), v.segments))
+        Ok((v.volume.in_frame()?, v.segments))
     } else {
-        Ok((parse_nifti(&raw, path)?.canonical(), None))
+        Ok((parse_nifti(&raw, path)?.in_frame()?, None))
     }
 }
 
 /// A label volume (NIfTI-1 or NRRD) and what its labels mean: the label table or tool's
 /// label list at `labels` ([`crate::LabelTable::from_path_with`]), or else the segment
-/// names a 3D Slicer segmentation carries, mapped onto known structures as `unmapped`
-/// says.
+/// names a 3D Slicer segmentation carries, mapped onto known structures as `mapping`
+/// says (an [`crate::label_names::Unmapped`] rule, or a
+/// [`crate::label_mapping::LabelMapping`] with the user's own names file).
 ///
 /// ```no_run
 /// use myoslice::io::read_segmentation;
@@ -47,9 +51,10 @@ pub fn read_label_volume(
 pub fn read_segmentation(
     volume: impl AsRef<std::path::Path>,
     labels: Option<&std::path::Path>,
-    unmapped: crate::label_names::Unmapped,
+    mapping: impl Into<crate::label_mapping::LabelMapping>,
 ) -> crate::Result<(crate::LabelVolume, crate::LabelTable)> {
     let volume = volume.as_ref();
+    let mapping = mapping.into();
     let (v, segments) = read_label_volume(volume)?;
     let table = match (labels, segments) {
         (Some(_), Some(_)) => {
@@ -59,11 +64,10 @@ pub fn read_segmentation(
                  the file's order), so no label file applies to it: leave the label file out",
             ));
         }
-        (Some(l), None) => crate::LabelTable::from_path_with(l, unmapped)?,
+        (Some(l), None) => crate::LabelTable::from_path_with(l, mapping)?,
         (None, Some(list)) => {
-            let names = crate::label_names::AnatomyNames::builtin()?;
             let origin = volume.display().to_string();
-            crate::label_names::map_labels(&list, names, unmapped, &origin)?.0
+            crate::label_names::map_labels(&list, mapping.names()?, mapping.unmapped(), &origin)?.0
         }
         (None, None) => {
             return Err(crate::Error::parse(
@@ -74,4 +78,35 @@ pub fn read_segmentation(
         }
     };
     Ok((v, table))
+}
+
+/// A label volume and its table from any input myoslice reads, told apart by content
+/// ([`InputKind::sniff`]): a label volume read as [`read_segmentation`] does, or a PNG
+/// stack (its folder or its manifest; the manifest names the labels, so `labels` must be
+/// None). A scenario is refused here: it builds a simulation of its own
+/// ([`crate::Scenario::build`]).
+pub fn read_input(
+    path: impl AsRef<std::path::Path>,
+    labels: Option<&std::path::Path>,
+    mapping: impl Into<crate::label_mapping::LabelMapping>,
+) -> crate::Result<(crate::LabelVolume, crate::LabelTable)> {
+    let path = path.as_ref();
+    match InputKind::sniff(path)? {
+        InputKind::Volume => read_segmentation(path, labels, mapping),
+        InputKind::PngStack { folder, manifest } => {
+            if labels.is_some() {
+                return Err(crate::Error::parse(
+                    path,
+                    "a PNG stack's manifest names its labels (labels_file or [labels]): \
+                     leave the label file out",
+                ));
+            }
+            read_png_stack(folder, Some(&manifest))
+        }
+        InputKind::Scenario => Err(crate::Error::parse(
+            path,
+            "a scenario: build it as a scenario (`myoslice run`, Scenario::from_path, \
+             Simulation.from_scenario), which brings its own model and settings",
+        )),
+    }
 }

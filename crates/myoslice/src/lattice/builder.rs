@@ -95,7 +95,8 @@ struct SliceData {
 }
 
 impl Lattice {
-    /// Builds the lattice body of a label volume.
+    /// Builds the lattice body of a label volume, brought into the body frame first
+    /// ([`LabelVolume::in_frame`]) when it is stored in another order or tilted.
     ///
     /// ```no_run
     /// use myoslice::prelude::*;
@@ -107,6 +108,15 @@ impl Lattice {
     pub fn build(volume: &LabelVolume, table: &LabelTable, opts: &BuildOptions) -> Result<Self> {
         opts.validate()?;
         volume.check_labels(table)?;
+        // Slices run across the body's long axis: a scan stored in another order or
+        // tilted is brought into the body frame first.
+        let in_frame;
+        let volume = if volume.is_in_frame() {
+            volume
+        } else {
+            in_frame = volume.clone().in_frame()?;
+            &in_frame
+        };
         let kind_of = table.kind_lut();
         let hist = volume.histogram();
         let count_kind = |k: TissueKind| -> u64 {

@@ -2,6 +2,7 @@
 //! read the knee and the muscles.
 
 mod config;
+mod from_files;
 mod models;
 mod schedule;
 mod stepping;
@@ -21,7 +22,7 @@ use stepping::Rollback;
 
 use crate::body::{BodyId, Skeleton, SkeletonOptions, knee_axis};
 use crate::error::{Error, Result, check_range};
-use crate::lattice::{BuildOptions, Lattice};
+use crate::lattice::Lattice;
 use crate::muscle::{
     Axis, BodyFrames, ChainLoad, ChainOptions, MuscleCatalogue, MuscleGroup, MuscleUnit,
 };
@@ -98,6 +99,8 @@ pub struct Simulation {
     rollback: Rollback,
     /// Wall-clock time of the `step` calls.
     timers: StepTimers,
+    /// What the build could not take from the catalogue (see `warnings`).
+    warnings: Vec<String>,
 }
 
 impl Simulation {
@@ -154,6 +157,21 @@ impl Simulation {
             .tissue
             .enabled
             .then(|| bone_surfaces(&lattice, &meshes));
+        let warnings = muscles
+            .iter()
+            .filter(|m| !catalogue.muscles.contains_key(&m.name))
+            .map(|m| {
+                format!(
+                    "muscle '{}' has no entry in the muscle catalogue: its parameters come \
+                     from its volume and length (max force {:.0} N, optimal fibre length \
+                     {:.3} m, tendon slack length {:.3} m)",
+                    m.name,
+                    m.hill.max_isometric_force,
+                    m.hill.optimal_fibre_length,
+                    m.hill.tendon_slack_length
+                )
+            })
+            .collect();
         let n = muscles.len();
         let mut sim = Self {
             lattice: Arc::new(lattice),
@@ -169,6 +187,7 @@ impl Simulation {
             scratch: Default::default(),
             rollback: Rollback::default(),
             timers: StepTimers::default(),
+            warnings,
         };
         // Moment arms (each step's torque report uses the last step's) and wrap state of
         // the chains as built.
@@ -244,45 +263,6 @@ impl Simulation {
         // After a jump a compliant fibre starts in static equilibrium with its tendon at
         // the new length (a step across the jump would read it as a huge velocity).
         self.start_fibres();
-    }
-
-    /// The built-in phantom with the default lattice options and muscle catalogue.
-    pub fn phantom(config: SimulationConfig) -> Result<Self> {
-        let (volume, table) = crate::phantom::Phantom::default().generate()?;
-        let lattice = Lattice::build(&volume, &table, &BuildOptions::default())?;
-        Self::new(lattice, config, &MuscleCatalogue::default())
-    }
-
-    /// A label volume (NIfTI-1 or NRRD) and its label table or a tool's label list (unknown
-    /// names are an error).
-    pub fn from_nifti(
-        volume: impl AsRef<std::path::Path>,
-        labels: impl AsRef<std::path::Path>,
-        build: &BuildOptions,
-        config: SimulationConfig,
-    ) -> Result<Self> {
-        Self::from_segmentation(
-            volume,
-            Some(labels.as_ref()),
-            crate::label_names::Unmapped::Error,
-            build,
-            config,
-        )
-    }
-
-    /// A label volume (NIfTI-1 or NRRD) with the meaning of its labels: a label table or
-    /// a tool's label list at `labels`, or, when None, the segment names of a 3D Slicer
-    /// segmentation (see [`crate::io::read_segmentation`]).
-    pub fn from_segmentation(
-        volume: impl AsRef<std::path::Path>,
-        labels: Option<&std::path::Path>,
-        unmapped: crate::label_names::Unmapped,
-        build: &BuildOptions,
-        config: SimulationConfig,
-    ) -> Result<Self> {
-        let (v, t) = crate::io::read_segmentation(volume, labels, unmapped)?;
-        let lattice = Lattice::build(&v, &t, build)?;
-        Self::new(lattice, config, &MuscleCatalogue::default())
     }
 
     /// The lattice body.

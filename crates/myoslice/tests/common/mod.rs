@@ -2,6 +2,8 @@
 #![allow(dead_code)]
 #![allow(clippy::unwrap_used)] // tests fail loudly by design
 
+pub mod tool_files;
+
 use std::path::PathBuf;
 use std::sync::OnceLock;
 

@@ -1,0 +1,132 @@
+//! What a file given to myoslice is, told by its content rather than its name.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, Result};
+
+/// What kind of input a path holds.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum InputKind {
+    /// A label volume: NIfTI-1/-2 (plain or gzip) or NRRD (`.nrrd`, `.nhdr`,
+    /// `.seg.nrrd`).
+    Volume,
+    /// A folder of PNG slices and its manifest.
+    PngStack {
+        /// The folder of slices.
+        folder: PathBuf,
+        /// The manifest.
+        manifest: PathBuf,
+    },
+    /// A scenario (TOML with `[model]` / `[simulation]`).
+    Scenario,
+}
+
+impl InputKind {
+    /// Reads the start of `path` (or looks into the folder) and says what it is.
+    ///
+    /// ```no_run
+    /// use myoslice::io::InputKind;
+    /// assert_eq!(InputKind::sniff("leg.seg.nrrd")?, InputKind::Volume);
+    /// # Ok::<(), myoslice::Error>(())
+    /// ```
+    pub fn sniff(path: impl AsRef<Path>) -> Result<Self> {
+        let path = path.as_ref();
+        if path.is_dir() {
+            let manifest = path.join("manifest.toml");
+            if !manifest.is_file() {
+                return Err(Error::parse(
+                    path,
+                    "a folder is read as PNG slices, but it has no manifest.toml",
+                ));
+            }
+            return Ok(Self::PngStack {
+                folder: path.to_path_buf(),
+                manifest,
+            });
+        }
+        let mut head = Vec::with_capacity(4096);
+        std::fs::File::open(path)
+            .and_then(|f| f.take(4096).read_to_end(&mut head))
+            .map_err(|e| Error::io(path, e))?;
+        if head.starts_with(&[0x1f, 0x8b]) || super::is_nrrd(&head) || is_nifti_header(&head) {
+            return Ok(Self::Volume);
+        }
+        // Text: a scenario or a PNG stack's manifest, by their keys. Only the start was
+        // read, so keys are looked for line by line rather than by parsing.
+        let text = String::from_utf8_lossy(&head);
+        let has = |key: &str| {
+            text.lines().any(|l| {
+                let l = l.trim_start();
+                l.starts_with(key) && l[key.len()..].trim_start().starts_with(['=', ']', '.'])
+            })
+        };
+        if has("[model") || has("[simulation") || has("[excitation") {
+            return Ok(Self::Scenario);
+        }
+        if has("pixel_size_mm") || has("slice_interval_mm") {
+            return Ok(Self::PngStack {
+                folder: path.parent().unwrap_or(Path::new(".")).to_path_buf(),
+                manifest: path.to_path_buf(),
+            });
+        }
+        Err(Error::parse(
+            path,
+            "neither a label volume (NIfTI, NRRD, 3D Slicer segmentation), a PNG stack's \
+             manifest nor a scenario",
+        ))
+    }
+}
+
+/// A NIfTI-1 (348) or NIfTI-2 (540) header size in either byte order.
+fn is_nifti_header(b: &[u8]) -> bool {
+    let Some(h) = b.get(..4) else { return false };
+    let h = [h[0], h[1], h[2], h[3]];
+    [i32::from_le_bytes(h), i32::from_be_bytes(h)]
+        .iter()
+        .any(|&n| n == 348 || n == 540)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn files_are_told_apart_by_content_whatever_their_names() {
+        let dir = std::env::temp_dir().join(format!("myoslice-kind-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let cases: [(&str, &[u8], Option<InputKind>); 6] = [
+            ("a.txt", b"NRRD0004\ntype: uint8\n", Some(InputKind::Volume)),
+            ("b.bin", &[0x1f, 0x8b, 8, 0], Some(InputKind::Volume)),
+            ("c.dat", &[0x5c, 0x01, 0, 0, 1, 2], Some(InputKind::Volume)),
+            (
+                "d.cfg",
+                b"# x\n[model]\nsource = \"phantom\"\n",
+                Some(InputKind::Scenario),
+            ),
+            (
+                "e.toml",
+                b"pixel_size_mm = [1, 1]\nslice_interval_mm = 2\n",
+                None,
+            ),
+            ("f.nii", b"hello", None),
+        ];
+        for (name, bytes, want) in cases {
+            let p = dir.join(name);
+            std::fs::write(&p, bytes).unwrap();
+            match (InputKind::sniff(&p), want) {
+                (Ok(k), Some(w)) => assert_eq!(k, w, "{name}"),
+                (Ok(InputKind::PngStack { manifest, .. }), None) if name == "e.toml" => {
+                    assert_eq!(manifest, p)
+                }
+                (Err(e), None) if name == "f.nii" => {
+                    assert!(e.to_string().contains("neither"), "{e}")
+                }
+                (got, _) => panic!("{name}: {got:?}"),
+            }
+        }
+        let e = InputKind::sniff(&dir).unwrap_err().to_string();
+        assert!(e.contains("manifest.toml"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
