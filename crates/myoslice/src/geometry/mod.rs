@@ -8,5 +8,5 @@ pub mod triangle;
 
 pub use bvh::{TriangleBvh, TriangleSet};
 pub use pose::Pose;
-pub use sdf::{BoneSdf, SdfSample};
+pub use sdf::{BoneSdf, SdfSample, SurfacePoint};
 pub use triangle::{Feature, closest_point, triangles_cross};

@@ -9,6 +9,8 @@
 //! where pseudo-normals are not: where one tube's wall runs inside another.
 
 use glam::{IVec3, Vec3};
+use parry3d::query::PointQuery;
+use parry3d::shape::TriMesh;
 use rayon::prelude::*;
 
 use super::triangle::{Feature, closest_point};
@@ -20,6 +22,20 @@ pub struct SdfSample {
     pub distance: f32,
     /// Unit direction of increasing distance (outward), rest frame.
     pub normal: Vec3,
+    /// The nearest surface point, where the sample is exact (within
+    /// [`BoneSdf::exact_within`] of the surface); None where it is interpolated.
+    pub nearest: Option<Vec3>,
+}
+
+/// The nearest point of a bone's surface to a query point, exactly.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfacePoint {
+    /// Signed distance (m): negative inside the bone.
+    pub distance: f32,
+    /// Unit outward direction at the query point (rest frame).
+    pub normal: Vec3,
+    /// The nearest surface point (rest frame).
+    pub point: Vec3,
 }
 
 /// Narrow-band signed distance field of a closed triangle surface.
@@ -311,6 +327,7 @@ impl BoneSdf {
             return Some(SdfSample {
                 distance: trilinear,
                 normal: Vec3::new(gx, gy, gz).normalize_or_zero(),
+                nearest: None,
             });
         }
         // Near the surface: exact, from the nodes' nearest triangles.
@@ -333,6 +350,7 @@ impl BoneSdf {
             return Some(SdfSample {
                 distance: trilinear,
                 normal: Vec3::ZERO,
+                nearest: None,
             });
         }
         let (d2, q, t, feature) = best;
@@ -364,6 +382,46 @@ impl BoneSdf {
         Some(SdfSample {
             distance: if inside { -dist } else { dist },
             normal,
+            nearest: Some(q),
+        })
+    }
+
+    /// The nearest point of the surface to `p` (rest frame) with its signed distance,
+    /// exact at any depth: from the field within [`Self::exact_within`] of the surface,
+    /// from `tree` (the same surface as a parry mesh) further, the field's sign saying
+    /// which side. None when `p` lies more than `within` outside the surface, known
+    /// from the field alone where it can tell (the interpolated distance a cell or more
+    /// beyond `within`, or outside the grid), so most far points cost one lookup.
+    pub fn nearest(&self, tree: &TriMesh, p: Vec3, within: f32) -> Option<SurfacePoint> {
+        let sample = self.sample(p);
+        if let Some(s) = sample {
+            if let Some(point) = s.nearest
+                && s.normal != Vec3::ZERO
+            {
+                return (s.distance <= within).then_some(SurfacePoint {
+                    distance: s.distance,
+                    normal: s.normal,
+                    point,
+                });
+            }
+            if s.distance - self.cell > within {
+                return None;
+            }
+        } else if within < self.band {
+            // The grid reaches `band` beyond the surface everywhere.
+            return None;
+        }
+        let proj = tree.project_local_point(p, false);
+        // Outside the field's grid is outside the bone.
+        let inside = sample.is_some_and(|s| s.distance < 0.0);
+        let off = p - proj.point;
+        let d = off.length();
+        let n = if d > 0.0 { off / d } else { Vec3::ZERO };
+        let (distance, normal) = if inside { (-d, -n) } else { (d, n) };
+        (distance <= within).then_some(SurfacePoint {
+            distance,
+            normal,
+            point: proj.point,
         })
     }
 }

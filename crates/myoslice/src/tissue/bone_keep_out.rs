@@ -59,6 +59,8 @@ const PLANE_STEP_M: f32 = 0.002;
 #[derive(Clone, Copy)]
 pub(crate) struct Bones<'a> {
     pub(crate) meshes: &'a [BoneMesh],
+    /// Each bone's distance field (rest frame), for exact measures.
+    pub(crate) sdfs: &'a [crate::geometry::BoneSdf],
     pub(crate) surfaces: &'a [(BodyId, TriMesh)],
     pub(crate) frames: &'a BodyFrames,
     /// Share of a ring's shift kept into this update (see [`fade_per_update`]).

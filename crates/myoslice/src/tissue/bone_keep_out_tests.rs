@@ -70,6 +70,7 @@ fn a_ring_a_bone_reaches_into_from_opposite_sides_is_not_pushed_away() {
     let frames = BodyFrames::REST;
     let b = Bones {
         meshes: &meshes,
+        sdfs: &[],
         surfaces: &bones,
         frames: &frames,
         fade: fade_per_update(30.0),
@@ -127,6 +128,7 @@ fn rings_past_the_contact_plane_go_back_to_their_side_and_rings_across_it_at_res
     let rest_plane = level_plane();
     let bones = |contact| Bones {
         meshes: &[],
+        sdfs: &[],
         surfaces: &[],
         frames: &frames,
         fade: fade_per_update(30.0),
@@ -236,6 +238,7 @@ fn rings_under_skin_that_faces_the_plane_keep_beneath_it() {
     };
     let with = |cover| Bones {
         meshes: &[],
+        sdfs: &[],
         surfaces: &[],
         frames: &frames,
         fade: fade_per_update(30.0),
@@ -286,6 +289,7 @@ fn carried_rings_find_what_fully_checked_rings_find() {
         let frames = if update < 10 { moved } else { BodyFrames::REST };
         let b = Bones {
             meshes: &meshes,
+            sdfs: &[],
             surfaces: &bones,
             frames: &frames,
             fade: fade_per_update(30.0),

@@ -15,13 +15,11 @@ pub struct BoneOverlap {
     pub deepest_m: f32,
 }
 
-/// Measures `vertices` against every bone (a tree query per vertex near a bone; exact
-/// for a surface that does not cross itself). `crossed[b]` says bone `b`'s surface
-/// crosses itself (tubes of one bone overlapping, or a tube folding): there the
-/// pseudo-normal can call a point outside inside, so the winding number confirms it;
-/// it can still miss a point inside one tube whose nearest surface is another tube's
-/// wall running inside it, and measures depth to that wall (a lower bound).
-pub(crate) fn overlap(vertices: &[Vec3], bones: &Bones, crossed: &[bool]) -> BoneOverlap {
+/// Measures `vertices` against every bone: a point its distance field calls more than
+/// 1 mm inside (or deeper than the deepest so far) is confirmed by the surface's winding
+/// number, as a user's tools decide inside, and its depth is the distance to the nearest
+/// surface point (exact at any depth).
+pub(crate) fn overlap(vertices: &[Vec3], bones: &Bones) -> BoneOverlap {
     let mut o = BoneOverlap::default();
     for (b, (body, mesh)) in bones.surfaces.iter().enumerate() {
         let (q, t) = bones.pose(*body);
@@ -31,14 +29,17 @@ pub(crate) fn overlap(vertices: &[Vec3], bones: &Bones, crossed: &[bool]) -> Bon
             if !aabb.contains_local_point(p_rest) {
                 continue;
             }
-            let w = bones.meshes[b].walk_from_tree(mesh, p_rest);
-            let d = w.point.distance(p_rest);
+            // Inside by the bone's distance field, depth to the nearest surface point.
+            let Some(s) = bones.sdfs[b].nearest(mesh, p_rest, 0.0) else {
+                continue;
+            };
+            let d = -s.distance;
             // Only what would change the result is confirmed (a winding number visits
             // every triangle).
-            if !w.inside || (d <= 1e-3 && d <= o.deepest_m) {
+            if d <= 0.0 || (d <= 1e-3 && d <= o.deepest_m) {
                 continue;
             }
-            if crossed[b] && winding_number(mesh.vertices(), mesh.indices(), p_rest).abs() < 0.5 {
+            if winding_number(mesh.vertices(), mesh.indices(), p_rest).abs() < 0.5 {
                 continue;
             }
             o.deepest_m = o.deepest_m.max(d);

@@ -2,10 +2,10 @@
 //! distance from the bone surface, measured in the bone's distance field (no memory of
 //! where it was: a walk from the last nearest triangle could settle on the wrong side of
 //! a condyle and hold the fat there for good). [`BoneMesh`] holds a bone's surface with
-//! its adjacency for the keep-out passes' walks.
+//! its adjacency for the muscles' keep-out walks.
 
 use glam::{Quat, Vec3};
-use parry3d::query::{PointQuery, PointQueryWithLocation};
+use parry3d::query::PointQueryWithLocation;
 use parry3d::shape::TriMesh;
 use rayon::prelude::*;
 
@@ -145,11 +145,6 @@ impl BoneMesh {
                 self.vertex_normals[self.triangles[t as usize][usize::from(k)] as usize]
             }
         }
-    }
-
-    /// Outward unit normal of triangle `t` (zero for a collapsed one).
-    pub(crate) fn normal(&self, t: u32) -> Vec3 {
-        self.normals.get(t as usize).copied().unwrap_or(Vec3::ZERO)
     }
 
     /// The body the bone moves with.
@@ -308,23 +303,10 @@ impl BoneSlide {
 }
 
 /// Signed distance of `p` (rest frame) from a bone's surface and the outward direction
-/// there: from the distance field near the surface, from the mesh's exact nearest point
-/// further out (the field's sign still says which side).
+/// there ([`BoneSdf::nearest`]: exact at any depth).
 fn surface_offset(sdf: &BoneSdf, mesh: &TriMesh, p: Vec3) -> (f32, Vec3) {
-    let sample = sdf.sample(p);
-    if let Some(s) = sample
-        && s.distance.abs() <= sdf.exact_within()
-        && s.normal != Vec3::ZERO
-    {
-        return (s.distance, s.normal);
-    }
-    let proj = mesh.project_local_point(p, false);
-    // Outside the field's grid is outside the bone.
-    let inside = sample.is_some_and(|s| s.distance < 0.0);
-    let off = p - proj.point;
-    let d = off.length();
-    let n = if d > 0.0 { off / d } else { Vec3::ZERO };
-    if inside { (-d, -n) } else { (d, n) }
+    sdf.nearest(mesh, p, f32::INFINITY)
+        .map_or((f32::INFINITY, Vec3::ZERO), |s| (s.distance, s.normal))
 }
 
 #[cfg(test)]

@@ -14,9 +14,9 @@ use parry3d::query::{Ray, RayCast};
 use parry3d::shape::TriMesh;
 use rayon::prelude::*;
 
-use super::bone_slide::BoneMesh;
 use super::knee_fold::{FoldZone, KneeFold};
 use crate::body::{BodyId, KneeAxis};
+use crate::geometry::BoneSdf;
 
 /// Clearance (m) kept from bone per layer above the inner one (the inner layer is not
 /// watched): the skin of a two-layer lattice keeps 5 mm off bone, about the skin and
@@ -36,17 +36,8 @@ const SWEEP_TO_DEG: i32 = 180;
 /// the tibial tuberosity), and the nearest way out serves.
 const MAX_EXIT_M: f32 = 0.03;
 
-/// What a pair last learnt: where its walk starts, and a place (bone frame) its vertex was
-/// known to lie at least so far outside the bone (m; 0 when not known).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct PairMemory {
-    triangle: u32,
-    at: Vec3,
-    clear_by: f32,
-}
-
-/// The (fat vertex, bone) pairs to watch, grouped by vertex, with what each pair last
-/// learnt.
+/// The (fat vertex, bone) pairs to watch, grouped by vertex. Nothing is remembered from
+/// one update to the next: each pair asks its bone's distance field afresh.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct FatKeepOut {
     /// Watched vertices, ascending.
@@ -57,8 +48,6 @@ pub(crate) struct FatKeepOut {
     /// Clearance (m) each pair keeps: its layer's, or its rest distance from the bone
     /// where that is less (so the rest shape itself is never pushed).
     clears: Vec<f32>,
-    /// What each pair last learnt (parallel to `bones`).
-    memory: Vec<PairMemory>,
     /// The knee axis (a point on it and its direction), the same in both bodies' rest
     /// frames: in front of the knee the skin lies further from it than the bone under it.
     axis: (Vec3, Vec3),
@@ -73,7 +62,7 @@ impl FatKeepOut {
         rest: &[Vec3],
         zone: &FoldZone,
         layer_of: impl Fn(usize) -> usize + Sync,
-        meshes: &[BoneMesh],
+        sdfs: &[BoneSdf],
         surfaces: &[(BodyId, TriMesh)],
     ) -> Self {
         let folds: Vec<KneeFold> = (SWEEP_FROM_DEG..=SWEEP_TO_DEG)
@@ -101,17 +90,18 @@ impl FatKeepOut {
                         f.point + Quat::from_axis_angle(f.axis, -f.theta) * (*p - f.point)
                     })
                     .collect();
-                let near: Vec<u32> = (0..meshes.len() as u32)
+                let near: Vec<u32> = (0..surfaces.len() as u32)
                     .filter(|&b| {
-                        let (mesh, tree) = (&meshes[b as usize], &surfaces[b as usize].1);
+                        let (body, tree) = &surfaces[b as usize];
                         let (lo, hi) = boxes[b as usize];
-                        let swept = match mesh.body() {
+                        let swept = match body {
                             BodyId::Thigh => &thigh,
                             BodyId::Shank => &shank,
                         };
                         swept.iter().any(|&p| {
                             let off_box = (lo - p).max(p - hi).max(Vec3::ZERO).length();
-                            off_box < clear + WATCH_M && mesh.clear_bound(p, tree) < clear + WATCH_M
+                            off_box < clear + WATCH_M
+                                && sdfs[b as usize].nearest(tree, p, clear + WATCH_M).is_some()
                         })
                     })
                     .collect();
@@ -126,34 +116,16 @@ impl FatKeepOut {
         for (v, clear, near) in watched {
             out.vertices.push(v);
             for b in near {
-                let (mesh, tree) = (&meshes[b as usize], &surfaces[b as usize].1);
-                let at_rest = mesh.walk_from_tree(tree, rest[v as usize]);
-                let rest_d = if at_rest.inside {
-                    0.0
-                } else {
-                    at_rest.point.distance(rest[v as usize])
-                };
+                let tree = &surfaces[b as usize].1;
+                let rest_d = sdfs[b as usize]
+                    .nearest(tree, rest[v as usize], f32::INFINITY)
+                    .map_or(0.0, |s| s.distance.max(0.0));
                 out.bones.push(b);
                 out.clears.push(clear.min(rest_d));
-                out.memory.push(PairMemory {
-                    triangle: at_rest.triangle,
-                    at: Vec3::ZERO,
-                    clear_by: 0.0,
-                });
             }
             out.start.push(out.bones.len() as u32);
         }
         out
-    }
-
-    /// What each pair last learnt: the state an update changes.
-    pub(crate) fn memory(&self) -> Vec<PairMemory> {
-        self.memory.clone()
-    }
-
-    /// Puts back what [`Self::memory`] took.
-    pub(crate) fn recall(&mut self, memory: Vec<PairMemory>) {
-        self.memory = memory;
     }
 
     /// Moves each free watched vertex of `x` (`free`: those the update relaxes, whose
@@ -164,31 +136,21 @@ impl FatKeepOut {
     /// (rotation, translation). A vertex watched against two bones is kept from each in
     /// turn, in bone order.
     pub(crate) fn apply(
-        &mut self,
+        &self,
         x: &mut [Vec3],
         free: &[bool],
-        meshes: &[BoneMesh],
+        sdfs: &[BoneSdf],
         surfaces: &[(BodyId, TriMesh)],
         pose: impl Fn(BodyId) -> (Quat, Vec3) + Sync,
     ) {
         let xs = &*x;
         let (start, bones, clears, (axis_at, axis)) =
             (&self.start, &self.bones, &self.clears, self.axis);
-        // Each vertex's pairs are a contiguous run of `memory`: split it per vertex, so
-        // vertices go in parallel and each is written back once, in order.
-        let mut runs: Vec<&mut [PairMemory]> = Vec::with_capacity(self.vertices.len());
-        let mut rest = self.memory.as_mut_slice();
-        for w in start.windows(2) {
-            let (run, tail) = rest.split_at_mut((w[1] - w[0]) as usize);
-            runs.push(run);
-            rest = tail;
-        }
         let moved: Vec<Option<(u32, Vec3)>> = self
             .vertices
             .par_iter()
-            .zip(runs.into_par_iter())
             .enumerate()
-            .map(|(i, (&v, memory))| {
+            .map(|(i, &v)| {
                 if !free[v as usize] {
                     return None;
                 }
@@ -198,61 +160,38 @@ impl FatKeepOut {
                     .iter()
                     .enumerate()
                 {
-                    let (mesh, tree) = (&meshes[*b as usize], &surfaces[*b as usize].1);
+                    let (sdf, (body, tree)) = (&sdfs[*b as usize], &surfaces[*b as usize]);
                     let clear = clears[start[i] as usize + k];
-                    let (q, t) = pose(mesh.body());
+                    let (q, t) = pose(*body);
                     let local = q.inverse() * (p - t);
-                    let m = &mut memory[k];
-                    // Most watched vertices are well clear: still within the ball they were
-                    // last known clear by, or vouched for by the distance grid.
-                    if m.clear_by - local.distance(m.at) > clear {
+                    // Most watched vertices are well clear: the field says so at once.
+                    let Some(w) = sdf.nearest(tree, local, clear) else {
                         continue;
-                    }
-                    let bound = mesh.clear_bound(local, tree);
-                    if bound > clear {
-                        (m.at, m.clear_by) = (local, bound);
-                        continue;
-                    }
-                    let w = mesh.walk_checked(m.triangle, local, tree);
-                    let d = w.point.distance(local);
-                    // A settled walk's nearest point may be only local: it vouches for no
-                    // ball, and the vertex is looked at again next update.
-                    (m.triangle, m.at, m.clear_by) = (w.triangle, local, 0.0);
-                    if !w.inside && d >= clear {
+                    };
+                    let inside = w.distance < 0.0;
+                    if !inside && w.distance >= clear {
                         continue;
                     }
                     let radial = local - axis_at;
                     let away = (radial - axis * radial.dot(axis)).try_normalize();
-                    let exit = away.filter(|_| w.inside).and_then(|dir| {
+                    let exit = away.filter(|_| inside).and_then(|dir| {
                         let toi = tree.cast_local_ray(&Ray::new(local, dir), MAX_EXIT_M, false)?;
                         let exit = local + dir * (toi + clear);
                         // Left through a face aslant the way out: its clearance from the
                         // nearest point, not along the way. Back in the bone (a concave
                         // part, or a surface that crosses itself): the nearest way out.
-                        let near = mesh.walk_checked(w.triangle, exit, tree);
-                        let d = near.point.distance(exit);
-                        if near.inside {
-                            None
-                        } else if d < clear {
-                            Some(
-                                near.point
-                                    + (exit - near.point) * (clear / d.max(f32::MIN_POSITIVE)),
-                            )
-                        } else {
-                            Some(exit)
+                        match sdf.nearest(tree, exit, clear) {
+                            None => Some(exit),
+                            Some(near) if near.distance < 0.0 => None,
+                            Some(near) => Some(near.point + near.normal * clear),
                         }
                     });
-                    let to = exit.unwrap_or_else(|| {
-                        let out = if w.inside {
-                            w.point - local
-                        } else {
-                            local - w.point
-                        };
-                        let out = out
-                            .try_normalize()
-                            .unwrap_or_else(|| mesh.normal(w.triangle));
-                        w.point + out * clear
-                    });
+                    let out = if w.normal == Vec3::ZERO {
+                        away.unwrap_or(Vec3::Z)
+                    } else {
+                        w.normal
+                    };
+                    let to = exit.unwrap_or(w.point + out * clear);
                     p = q * to + t;
                     moved = true;
                 }
@@ -269,10 +208,11 @@ impl FatKeepOut {
 mod tests {
     use super::*;
 
-    /// A box bone `lo..hi` (rest frame) on `body`, with its parry mesh.
-    fn box_bone(body: BodyId, lo: Vec3, hi: Vec3) -> (BoneMesh, (BodyId, TriMesh)) {
+    /// A box bone `lo..hi` (rest frame) on `body`: its distance field and parry mesh.
+    fn box_bone(body: BodyId, lo: Vec3, hi: Vec3) -> (BoneSdf, (BodyId, TriMesh)) {
         let mesh = crate::tissue::test_shapes::box_mesh(lo, hi);
-        (BoneMesh::new(body, &mesh), (body, mesh))
+        let sdf = BoneSdf::new(mesh.vertices(), mesh.indices(), 0.002, 0.01);
+        (sdf, (body, mesh))
     }
 
     /// Signed distance from `p` to the box `lo..hi` (negative inside).
@@ -292,7 +232,7 @@ mod tests {
             condyle_radius: 0.02,
         };
         let (lo, hi) = (Vec3::new(-0.01, -0.06, 0.03), Vec3::new(0.01, -0.045, 0.05));
-        let (mesh, surface) = box_bone(BodyId::Shank, lo, hi);
+        let (sdf, surface) = box_bone(BodyId::Shank, lo, hi);
         let at = |psi: f32, r: f32| {
             let psi = psi.to_radians();
             Vec3::new(0.0, -r * psi.sin(), r * psi.cos())
@@ -313,9 +253,9 @@ mod tests {
         rest.push(Vec3::new(0.0, -0.05, 0.052));
         let layer_of = |v: usize| if v == inner { 0 } else { 2 };
         let zone = FoldZone::new(&knee, &rest, &[]);
-        let meshes = [mesh];
+        let sdfs = [sdf];
         let surfaces = [surface];
-        let mut keep = FatKeepOut::new(&knee, &rest, &zone, layer_of, &meshes, &surfaces);
+        let keep = FatKeepOut::new(&knee, &rest, &zone, layer_of, &sdfs, &surfaces);
         // The arc's skin near the box, not the inner vertex, the skin behind the knee nor
         // the skin far off.
         let watched: Vec<u32> = keep.vertices.clone();
@@ -336,7 +276,7 @@ mod tests {
         // At rest nothing moves.
         let mut x = rest.clone();
         let pose = |_| (Quat::IDENTITY, Vec3::ZERO);
-        keep.apply(&mut x, &free, &meshes, &surfaces, pose);
+        keep.apply(&mut x, &free, &sdfs, &surfaces, pose);
         assert_eq!(x, rest);
         assert!(watched.contains(&(close as u32)));
         let (mut inside, mut lifted) = (0, 0);
@@ -346,7 +286,7 @@ mod tests {
             let turn = Quat::from_axis_angle(Vec3::X, theta);
             let mut x: Vec<Vec3> = rest.iter().map(|&p| fold.map(p)).collect();
             let before = x.clone();
-            keep.apply(&mut x, &free, &meshes, &surfaces, |b| match b {
+            keep.apply(&mut x, &free, &sdfs, &surfaces, |b| match b {
                 BodyId::Thigh => (Quat::IDENTITY, Vec3::ZERO),
                 BodyId::Shank => (turn, Vec3::ZERO),
             });
@@ -381,29 +321,21 @@ mod tests {
 
     /// A keep-out of one box bone `0..20 mm` on the thigh for `n` vertices, clearance 3 mm,
     /// its axis along x through (10, 10, −1000) mm (so away from it is +z at the box).
-    fn box_keep_out(n: usize) -> (FatKeepOut, BoneMesh, (BodyId, TriMesh)) {
-        let (mesh, surface) = box_bone(BodyId::Thigh, Vec3::ZERO, Vec3::splat(0.02));
+    fn box_keep_out(n: usize) -> (FatKeepOut, BoneSdf, (BodyId, TriMesh)) {
+        let (sdf, surface) = box_bone(BodyId::Thigh, Vec3::ZERO, Vec3::splat(0.02));
         let keep = FatKeepOut {
             vertices: (0..n as u32).collect(),
             start: (0..=n as u32).collect(),
             bones: vec![0; n],
             clears: vec![0.003; n],
-            memory: vec![
-                PairMemory {
-                    triangle: 0,
-                    at: Vec3::ZERO,
-                    clear_by: 0.0,
-                };
-                n
-            ],
             axis: (Vec3::new(0.01, 0.01, -1.0), Vec3::X),
         };
-        (keep, mesh, surface)
+        (keep, sdf, surface)
     }
 
     #[test]
     fn a_free_vertex_inside_a_bone_or_too_near_it_goes_out_to_its_clearance() {
-        let (mut keep, mesh, surface) = box_keep_out(5);
+        let (keep, sdf, surface) = box_keep_out(5);
         // Inside under the top face (away from the axis is up), just above the top face,
         // just beside the side face x = 20 mm, well clear, and inside but not free.
         let mut x = vec![
@@ -415,7 +347,7 @@ mod tests {
         ];
         let free = [true, true, true, true, false];
         let pose = |_| (Quat::IDENTITY, Vec3::ZERO);
-        keep.apply(&mut x, &free, &[mesh], &[surface], pose);
+        keep.apply(&mut x, &free, &[sdf], &[surface], pose);
         let top = Vec3::new(0.01, 0.01, 0.023);
         assert!(x[0].distance(top) < 1e-6, "{:?}", x[0]);
         assert!(x[1].distance(top) < 1e-6, "{:?}", x[1]);
@@ -429,15 +361,15 @@ mod tests {
     }
 
     #[test]
-    fn a_vertex_once_known_clear_is_pushed_when_it_comes_into_the_bone() {
-        let (mut keep, mesh, surface) = box_keep_out(1);
-        let (meshes, surfaces) = ([mesh], [surface]);
+    fn a_vertex_coming_nearer_step_by_step_is_pushed_once_within_its_clearance() {
+        let (keep, sdf, surface) = box_keep_out(1);
+        let (sdfs, surfaces) = ([sdf], [surface]);
         let pose = |_| (Quat::IDENTITY, Vec3::ZERO);
         // Far above the box, then nearer step by step, then inside: each time it is kept
-        // at least its clearance out, the remembered ball notwithstanding.
+        // at least its clearance out.
         for z in [0.06, 0.05, 0.04, 0.03, 0.024, 0.022, 0.01] {
             let mut x = vec![Vec3::new(0.01, 0.01, z)];
-            keep.apply(&mut x, &[true], &meshes, &surfaces, pose);
+            keep.apply(&mut x, &[true], &sdfs, &surfaces, pose);
             assert!(x[0].z > 0.023 - 1e-6, "from {z}: {:?}", x[0]);
             assert_eq!(x[0].z == z, z >= 0.023, "from {z}: {:?}", x[0]);
         }

@@ -30,7 +30,7 @@ mod tissue_backup;
 mod tissue_config;
 mod update_back;
 
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 use parry3d::shape::TriMesh;
@@ -78,8 +78,10 @@ const RIGID_TOLERANCE_M2: f32 = 1e-8;
 /// [`SDF_BAND_M`] − 2 cells of the surface, interpolated beyond.
 const SDF_CELL_M: f32 = 0.002;
 
-/// How far (m) from each bone's surface its distance field holds exact distances.
-const SDF_BAND_M: f32 = 0.006;
+/// How far (m) from each bone's surface its distance field holds exact distances: the
+/// field answers exactly within 6 mm, past the skin's clearance over bone in front of the
+/// knee (5 mm), so the keep-outs seldom need the mesh's tree.
+const SDF_BAND_M: f32 = 0.010;
 
 /// Bone surfaces for tissue queries: body and mesh (rest frame) of each lattice bone.
 pub type BoneSurfaces = Arc<Vec<(BodyId, TriMesh)>>;
@@ -105,7 +107,7 @@ struct TissueStatic {
     guard_triangles: Vec<[u32; 3]>,
     /// Where the knee fold can bend the fat.
     zone: FoldZone,
-    /// Bone surfaces with adjacency, lattice bone order.
+    /// Bone surfaces with adjacency, lattice bone order (the muscles' keep-out walks).
     bone_meshes: Vec<BoneMesh>,
     /// The same surfaces as parry meshes (with a tree, for the rare global query).
     bones: BoneSurfaces,
@@ -113,13 +115,12 @@ struct TissueStatic {
     bone_sdfs: Vec<BoneSdf>,
     /// Fat vertices that slide on bone.
     bone_slide: BoneSlide,
+    /// Fat vertices the fold can bring near a bone, kept out of it.
+    fat_keep_out: FatKeepOut,
     /// Outer (skin) face of each outer-layer element and its rest area (m²).
     outer_faces: Vec<(u32, [u32; 4], f64)>,
     /// The skin closed at both ends (for [`Tissue::muscles_outside_skin`]).
     skin: ClosedSkin,
-    /// Whether each bone's surface crosses itself (see [`bone_overlap::overlap`]),
-    /// found when first needed.
-    bones_crossed: OnceLock<Vec<bool>>,
 }
 
 /// What the front half of an update hands its back half (see [`Tissue::update_front`]).
@@ -166,8 +167,6 @@ pub struct Tissue {
     /// The fat solver.
     pub fat: FatSolver,
     fixed: Arc<TissueStatic>,
-    /// Fat vertices the fold can bring near a bone, kept out of it.
-    fat_keep_out: FatKeepOut,
     /// Motion of the last update beyond the skinned guess (for momentum).
     drift: Vec<Vec3>,
     scratch: Scratch,
@@ -272,7 +271,7 @@ impl Tissue {
             &fat.vertices,
             &zone,
             |v| v % (fat.layers + 1),
-            &bone_meshes,
+            &bone_sdfs,
             &bones,
         );
         let fixed = TissueStatic {
@@ -290,19 +289,18 @@ impl Tissue {
             guard_triangles,
             zone,
             bone_slide: BoneSlide::new(&on_bone, &fat.vertices, &bone_sdfs, &bones),
+            fat_keep_out,
             bone_meshes,
             bones: Arc::clone(&bones),
             bone_sdfs,
             outer_faces,
             skin: ClosedSkin::new(fat),
-            bones_crossed: OnceLock::new(),
         };
         let tissue = Self {
             config,
             muscles: shapes,
             drift: vec![Vec3::ZERO; nv],
             fat: solver,
-            fat_keep_out,
             fixed: Arc::new(fixed),
             scratch: Scratch::default(),
             knee,
@@ -513,10 +511,10 @@ impl Tissue {
             pose,
         );
         // The skin in front of the knee lifts over bone the fold brings under it.
-        self.fat_keep_out.apply(
+        fixed.fat_keep_out.apply(
             &mut self.fat.x,
             &self.fat.free,
-            &fixed.bone_meshes,
+            &fixed.bone_sdfs,
             &fixed.bones,
             pose,
         );

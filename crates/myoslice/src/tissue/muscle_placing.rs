@@ -47,6 +47,7 @@ impl Placing<'_> {
         );
         let bones = Bones {
             meshes: &self.fixed.bone_meshes,
+            sdfs: &self.fixed.bone_sdfs,
             surfaces: &self.fixed.bones,
             frames,
             fade: bone_keep_out::fade_per_update(self.config.rate_hz),

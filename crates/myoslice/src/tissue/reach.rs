@@ -5,35 +5,27 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::bone_keep_out::Bones;
-use super::{BoneOverlap, SkinBreach, Tissue, bone_overlap, intersect};
+use super::{BoneOverlap, SkinBreach, Tissue, bone_overlap};
 use crate::muscle::BodyFrames;
 
 impl Tissue {
     /// How far each muscle's surface reaches into bone with the bodies at `frames`, in
-    /// muscle order (one tree query per muscle vertex near a bone, and a winding number
-    /// where a bone's surface crosses itself; exact but for points inside one tube of a
-    /// bone whose nearest surface is another tube's wall: for checks, not for every
-    /// update; the first call also finds which bone surfaces cross themselves, about
-    /// 15 ms).
+    /// muscle order (a distance-field query per muscle vertex near a bone, and the
+    /// winding number of what it calls inside by more than 1 mm: for checks, not for
+    /// every update).
     pub fn muscles_in_bone(&self, frames: &BodyFrames) -> Vec<BoneOverlap> {
         let bones = Bones {
             meshes: &self.fixed.bone_meshes,
+            sdfs: &self.fixed.bone_sdfs,
             surfaces: &self.fixed.bones,
             frames,
             fade: 1.0,
             contact: None,
             cover: None,
         };
-        let crossed = self.fixed.bones_crossed.get_or_init(|| {
-            self.fixed
-                .bones
-                .par_iter()
-                .map(|(_, m)| intersect::self_intersections(m.vertices(), m.indices()) > 0)
-                .collect()
-        });
         self.muscles
             .par_iter()
-            .map(|m| bone_overlap::overlap(&m.current, &bones, crossed))
+            .map(|m| bone_overlap::overlap(&m.current, &bones))
             .collect()
     }
 

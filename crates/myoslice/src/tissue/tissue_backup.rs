@@ -3,7 +3,6 @@
 use glam::{Quat, Vec3};
 
 use super::bone_keep_out::KeepOutMemory;
-use super::fat_keep_out::PairMemory;
 use super::metrics::LazyMetrics;
 use super::{GuardTally, Tissue};
 
@@ -18,14 +17,13 @@ pub(crate) struct TissueBackup {
     theta: f32,
     metrics: LazyMetrics,
     guard_tally: GuardTally,
-    fat_keep_out: Vec<PairMemory>,
+    /// Each muscle's vertices, volume and keep-out memory.
     muscles: Vec<(Vec<Vec3>, f64, KeepOutMemory)>,
 }
 
 impl Tissue {
-    /// Everything an update changes and the next one reads, the pairs watched against
-    /// bone included (where each walk starts). Not the clock: `step` advances it and puts
-    /// it back itself.
+    /// Everything an update changes and the next one reads. Not the clock: `step`
+    /// advances it and puts it back itself.
     pub(crate) fn backup(&self) -> TissueBackup {
         TissueBackup {
             fat_x: self.fat.x.clone(),
@@ -36,7 +34,6 @@ impl Tissue {
             theta: self.theta,
             metrics: self.metrics.clone(),
             guard_tally: self.guard_tally,
-            fat_keep_out: self.fat_keep_out.memory(),
             muscles: self
                 .muscles
                 .iter()
@@ -51,7 +48,6 @@ impl Tissue {
         (self.fat.free, self.fat.active) = (b.fat_free, b.fat_active);
         (self.drift, self.theta, self.metrics) = (b.drift, b.theta, b.metrics);
         self.guard_tally = b.guard_tally;
-        self.fat_keep_out.recall(b.fat_keep_out);
         // Shapes placed ahead for an update that will not come now.
         self.placed = None;
         for (shape, (c, v, keep)) in self.muscles.iter_mut().zip(b.muscles) {
