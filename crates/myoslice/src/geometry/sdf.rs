@@ -428,7 +428,10 @@ impl BoneSdf {
 
 /// Face normals with the edge pseudo-normals of each triangle (the sum of its two faces'
 /// normals), and the angle-weighted pseudo-normal of each vertex.
-fn pseudo_normals(vertices: &[Vec3], triangles: &[[u32; 3]]) -> (Vec<[Vec3; 4]>, Vec<Vec3>) {
+pub(crate) fn pseudo_normals(
+    vertices: &[Vec3],
+    triangles: &[[u32; 3]],
+) -> (Vec<[Vec3; 4]>, Vec<Vec3>) {
     let faces: Vec<Vec3> = triangles
         .iter()
         .map(|t| {

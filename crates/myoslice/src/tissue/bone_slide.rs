@@ -11,6 +11,7 @@ use rayon::prelude::*;
 
 use super::distance_grid::DistanceGrid;
 use crate::body::BodyId;
+use crate::geometry::sdf::pseudo_normals;
 use crate::geometry::{BoneSdf, Feature, closest_point};
 
 /// Most triangles a walk visits before it settles for the best seen.
@@ -22,10 +23,9 @@ pub(crate) struct BoneMesh {
     body: BodyId,
     vertices: Vec<Vec3>,
     triangles: Vec<[u32; 3]>,
-    /// Outward unit normal of each triangle.
-    normals: Vec<Vec3>,
-    /// Pseudo-normal of each triangle's edges (ab, bc, ca): the sum of the two faces'.
-    edge_normals: Vec<[Vec3; 3]>,
+    /// Per triangle: outward unit normal, then the pseudo-normals of its edges (ab, bc,
+    /// ca), the mean of the two faces' (the distance field's own).
+    face_normals: Vec<[Vec3; 4]>,
     /// Angle-weighted pseudo-normal of each vertex (Bærentzen and Aanæs 2005): which side
     /// of the surface a point lies on, whatever feature is nearest it.
     vertex_normals: Vec<Vec3>,
@@ -56,28 +56,7 @@ impl BoneMesh {
     pub(crate) fn new(body: BodyId, mesh: &TriMesh) -> Self {
         let vertices = mesh.vertices().to_vec();
         let triangles = mesh.indices().to_vec();
-        let normals: Vec<Vec3> = triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| vertices[i as usize]);
-                (b - a).cross(c - a).normalize_or_zero()
-            })
-            .collect();
-        let mut vertex_normals = vec![Vec3::ZERO; vertices.len()];
-        for (t, n) in triangles.iter().zip(&normals) {
-            // A collapsed triangle has no normal to give (and its angles are not numbers).
-            if *n == Vec3::ZERO {
-                continue;
-            }
-            for k in 0..3 {
-                let p = vertices[t[k] as usize];
-                let (u, w) = (
-                    vertices[t[(k + 1) % 3] as usize] - p,
-                    vertices[t[(k + 2) % 3] as usize] - p,
-                );
-                vertex_normals[t[k] as usize] += *n * u.angle_between(w);
-            }
-        }
+        let (face_normals, vertex_normals) = pseudo_normals(&vertices, &triangles);
         let mut edges: Vec<((u32, u32), u32, u8)> = triangles
             .iter()
             .enumerate()
@@ -90,7 +69,6 @@ impl BoneMesh {
             .collect();
         edges.sort_unstable();
         let mut neighbours = vec![[u32::MAX; 3]; triangles.len()];
-        let mut edge_normals: Vec<[Vec3; 3]> = normals.iter().map(|n| [*n; 3]).collect();
         for w in edges.windows(2) {
             if w[0].0 == w[1].0 {
                 let (t0, k0, t1, k1) = (
@@ -101,8 +79,6 @@ impl BoneMesh {
                 );
                 neighbours[t0][k0] = t1 as u32;
                 neighbours[t1][k1] = t0 as u32;
-                let sum = normals[t0] + normals[t1];
-                (edge_normals[t0][k0], edge_normals[t1][k1]) = (sum, sum);
             }
         }
         let (fan_start, corners) = super::incidence::vertex_corners(vertices.len(), &triangles);
@@ -120,8 +96,7 @@ impl BoneMesh {
             body,
             vertices,
             triangles,
-            normals,
-            edge_normals,
+            face_normals,
             vertex_normals,
             neighbours,
             fan_start,
@@ -139,8 +114,8 @@ impl BoneMesh {
     /// The outward pseudo-normal at `feature` of triangle `t`.
     fn pseudo_normal(&self, t: u32, feature: Feature) -> Vec3 {
         match feature {
-            Feature::Face => self.normals[t as usize],
-            Feature::Edge(k) => self.edge_normals[t as usize][usize::from(k)],
+            Feature::Face => self.face_normals[t as usize][0],
+            Feature::Edge(k) => self.face_normals[t as usize][1 + usize::from(k)],
             Feature::Vertex(k) => {
                 self.vertex_normals[self.triangles[t as usize][usize::from(k)] as usize]
             }
