@@ -198,6 +198,7 @@ impl PySimulation {
         let sim = py
             .detach(move || Scenario::from_path(&path)?.build())
             .or_py(py)?;
+        sources::warn(py, sim.warnings())?;
         Ok(Self {
             sim,
             offscreen: None,

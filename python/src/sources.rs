@@ -72,7 +72,8 @@ pub(crate) fn warn(py: Python<'_>, warnings: &[String]) -> PyResult<()> {
     let warn = py.import("warnings")?.getattr("warn")?;
     let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
     for w in warnings {
-        warn.call1((w, &category, 3))?;
+        // Called from Rust, the innermost Python frame is the caller's line.
+        warn.call1((w, &category, 1))?;
     }
     Ok(())
 }

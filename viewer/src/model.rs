@@ -51,7 +51,7 @@ impl ModelSource {
                 if let Some(n) = names {
                     mapping = mapping.with_names_file(n)?;
                 }
-                Simulation::from_segmentation(
+                Simulation::from_file(
                     volume,
                     labels.as_deref(),
                     mapping,

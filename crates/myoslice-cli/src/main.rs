@@ -134,8 +134,9 @@ struct ModelArgs {
     /// Use the built-in phantom (the default when no volume is given).
     #[arg(long, conflicts_with_all = ["volume", "labels"])]
     phantom: bool,
-    /// Label volume: NIfTI-1 (.nii, .nii.gz) or NRRD (.nrrd, .nhdr); a 3D Slicer
-    /// segmentation (.seg.nrrd) names its own labels.
+    /// Label volume: NIfTI-1/-2 (.nii, .nii.gz) or NRRD (.nrrd, .nhdr), or a PNG stack
+    /// (folder or manifest), told apart by content; a 3D Slicer segmentation (.seg.nrrd)
+    /// names its own labels.
     #[arg(long)]
     volume: Option<PathBuf>,
     /// Label table (.json, .toml), ITK-SNAP label description file or 3D Slicer colour

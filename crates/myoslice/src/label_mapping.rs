@@ -145,8 +145,12 @@ impl LabelMapping {
             s.name = name;
             names.add_structure(s, origin)?;
         }
-        for (given, target) in raw.map {
-            let Some(i) = names.position(&target) else {
+        // Every target is read against the table before any entry changes it: the
+        // entries act together, whatever order their keys sort in ("A" = "b" with
+        // "B" = "a" swaps two names).
+        let mut aliases = Vec::with_capacity(raw.map.len());
+        for (given, target) in &raw.map {
+            let Some(i) = names.position(target) else {
                 return Err(Error::parse(
                     origin,
                     format!(
@@ -156,7 +160,10 @@ impl LabelMapping {
                     ),
                 ));
             };
-            if !names.set_alias(&given, i) {
+            aliases.push((given, i));
+        }
+        for (given, i) in aliases {
+            if !names.set_alias(given, i) {
                 return Err(Error::parse(
                     origin,
                     format!("map.\"{given}\": the name has no words left to compare"),
@@ -187,6 +194,39 @@ mod tests {
         // The built-in table itself is untouched.
         let builtin = AnatomyNames::builtin().unwrap();
         assert_eq!(builtin.lookup("femur").unwrap().name, "femur");
+    }
+
+    #[test]
+    fn map_entries_act_together_whatever_order_they_sort_in() {
+        // Two names swapped in the user's segmentation.
+        let text = "[map]\n\"Rectus femoris\" = \"vastus_lateralis\"\n\
+                    \"Vastus lateralis\" = \"rectus_femoris\"\n\"thigh bone\" = \"femur\"\n\
+                    Femur = \"background\"\n";
+        let m = LabelMapping::new(Unmapped::Error)
+            .with_names_str(text, "n.toml")
+            .unwrap();
+        let names = m.names().unwrap();
+        let read = |n: &str| names.lookup(n).map(|s| s.name.clone());
+        assert_eq!(read("rectus femoris").as_deref(), Some("vastus_lateralis"));
+        assert_eq!(read("vastus lateralis").as_deref(), Some("rectus_femoris"));
+        assert_eq!(read("thigh bone").as_deref(), Some("femur"));
+        assert_eq!(read("femur").as_deref(), Some("background"));
+        // Attachments follow the structure, not the name: the swap keeps each muscle's.
+        let list = [
+            (1, "Vastus lateralis".to_string()),
+            (2, "Rectus femoris".to_string()),
+            (3, "hip".to_string()),
+            (4, "patella".to_string()),
+            (5, "thigh bone".to_string()),
+        ];
+        let (table, _) =
+            crate::label_names::map_labels(&list, names, Unmapped::Error, "t").unwrap();
+        let rf = table.by_name("rectus_femoris").unwrap();
+        let vl = table.by_name("vastus_lateralis").unwrap();
+        assert_eq!(
+            (rf.id, rf.origin.as_deref(), vl.id, vl.origin.as_deref()),
+            (1, Some("hip_bone"), 2, Some("femur"))
+        );
     }
 
     #[test]

@@ -172,6 +172,11 @@ impl AnatomyNames {
             .map(|&i| &self.structures[i])
     }
 
+    /// The structure of this canonical name (whatever names the table maps onto others).
+    pub fn structure(&self, canonical: &str) -> Option<&Structure> {
+        self.structures.iter().find(|s| s.name == canonical)
+    }
+
     /// Every structure, by canonical name.
     pub fn structures(&self) -> &[Structure] {
         &self.structures
@@ -284,7 +289,7 @@ pub fn map_labels(
     let labels = mapped
         .iter()
         .map(|m| {
-            let s = m.structure.as_deref().and_then(|s| names.lookup(s));
+            let s = m.structure.as_deref().and_then(|s| names.structure(s));
             let muscle = m.kind == TissueKind::Muscle;
             Label {
                 id: m.id,

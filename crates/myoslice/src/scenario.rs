@@ -259,7 +259,22 @@ impl Scenario {
             }
         }
         match raw.model.source.as_str() {
-            "phantom" => {}
+            "phantom" => {
+                for (k, given) in [
+                    ("names", raw.model.names.is_some()),
+                    ("unmapped", raw.model.unmapped.is_some()),
+                    ("volume", raw.model.volume.is_some()),
+                    ("labels", raw.model.labels.is_some()),
+                ] {
+                    if given {
+                        return Err(err(format!(
+                            "model.{k}{}: only for model.source = \"nifti\" (the phantom has \
+                             its own labels)",
+                            line_of(k)
+                        )));
+                    }
+                }
+            }
             "nifti" => {
                 let Some(volume) = &raw.model.volume else {
                     return Err(err(
@@ -373,13 +388,7 @@ impl Scenario {
                 if let Some(n) = &self.model.names {
                     mapping = mapping.with_names_file(resolve(&self.path, n))?;
                 }
-                Simulation::from_segmentation(
-                    v,
-                    l.as_deref(),
-                    mapping,
-                    &self.build_options(),
-                    config,
-                )?
+                Simulation::from_file(v, l.as_deref(), mapping, &self.build_options(), config)?
             }
             _ => {
                 let (volume, table) = crate::phantom::Phantom::default().generate()?;
@@ -509,6 +518,19 @@ mod tests {
         assert!(e.contains("duration_s") && e.contains("line 2"), "{e}");
         let e = parse("[model]\nsource = \"nifti\"\nvolume = \"nope.nii\"\nlabels = \"nope.json\"\n[simulation]\nduration_s = 1\n").unwrap_err().to_string();
         assert!(e.contains("model.volume") && e.contains("not found"), "{e}");
+        let e = parse(
+            "[model]\nsource = \"phantom\"\nnames = \"n.toml\"\n[simulation]\nduration_s = 1\n",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("model.names (line 3)") && e.contains("only for"),
+            "{e}"
+        );
+        let e = parse("[model]\nsource = \"nifti\"\n[simulation]\nduration_s = 1\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("model.volume is required"), "{e}");
         let e = parse("[simulation]\nduration_s = 1\n[excitation]\nx = [[0.0, 2.0]]\n")
             .unwrap_err()
             .to_string();

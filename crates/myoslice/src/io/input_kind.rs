@@ -55,6 +55,7 @@ impl InputKind {
         // Text: a scenario or a PNG stack's manifest, by their keys. Only the start was
         // read, so keys are looked for line by line rather than by parsing.
         let text = String::from_utf8_lossy(&head);
+        let text = text.trim_start_matches('\u{feff}');
         let has = |key: &str| {
             text.lines().any(|l| {
                 let l = l.trim_start();
@@ -66,9 +67,26 @@ impl InputKind {
         }
         if has("pixel_size_mm") || has("slice_interval_mm") {
             return Ok(Self::PngStack {
-                folder: path.parent().unwrap_or(Path::new(".")).to_path_buf(),
+                folder: path
+                    .parent()
+                    .filter(|p| !p.as_os_str().is_empty())
+                    .unwrap_or(Path::new("."))
+                    .to_path_buf(),
                 manifest: path.to_path_buf(),
             });
+        }
+        // Binary, or named as a volume: the volume readers say what is wrong with it
+        // (a damaged header), which says more than that nothing matched.
+        let named_volume = path
+            .file_name()
+            .map(|n| n.to_string_lossy().to_ascii_lowercase())
+            .is_some_and(|n| {
+                [".nii", ".nii.gz", ".nrrd", ".nhdr", ".gz"]
+                    .iter()
+                    .any(|e| n.ends_with(e))
+            });
+        if named_volume || head.contains(&0) || std::str::from_utf8(&head).is_err() {
+            return Ok(Self::Volume);
         }
         Err(Error::parse(
             path,
@@ -109,7 +127,7 @@ mod tests {
                 b"pixel_size_mm = [1, 1]\nslice_interval_mm = 2\n",
                 None,
             ),
-            ("f.nii", b"hello", None),
+            ("f.txt", b"hello", None),
         ];
         for (name, bytes, want) in cases {
             let p = dir.join(name);
@@ -119,7 +137,7 @@ mod tests {
                 (Ok(InputKind::PngStack { manifest, .. }), None) if name == "e.toml" => {
                     assert_eq!(manifest, p)
                 }
-                (Err(e), None) if name == "f.nii" => {
+                (Err(e), None) if name == "f.txt" => {
                     assert!(e.to_string().contains("neither"), "{e}")
                 }
                 (got, _) => panic!("{name}: {got:?}"),
@@ -127,6 +145,14 @@ mod tests {
         }
         let e = InputKind::sniff(&dir).unwrap_err().to_string();
         assert!(e.contains("manifest.toml"), "{e}");
+        // A damaged volume goes to its reader, which names what is wrong.
+        let nii = dir.join("leg.nii");
+        std::fs::write(&nii, b"not a header").unwrap();
+        assert_eq!(InputKind::sniff(&nii).unwrap(), InputKind::Volume);
+        let e = crate::io::read_input(&nii, None, crate::label_names::Unmapped::Error)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("348-byte NIfTI-1 header"), "{e}");
         std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -1,5 +1,5 @@
-//! Readers and writers of label volumes (NIfTI-1, NRRD, PNG stacks), and of the label
-//! lists of segmentation tools.
+//! Readers and writers of label volumes (NIfTI-1 and -2, NRRD, PNG stacks), and of the
+//! label lists of segmentation tools.
 
 pub mod input_kind;
 pub mod label_lists;
@@ -11,7 +11,7 @@ pub use input_kind::InputKind;
 pub use label_lists::{LabelListFormat, LabelNames, parse_label_list, sniff_label_list};
 pub use nifti::{MAX_VOLUME_BYTES, encode_nifti, parse_nifti, read_nifti, write_nifti};
 pub use nrrd::{NrrdVolume, is_nrrd, parse_nrrd, read_nrrd};
-pub use png_stack::{decode_png_labels, read_png_stack, write_png_labels};
+pub use png_stack::{decode_png_labels, read_png_stack, read_png_stack_with, write_png_labels};
 
 /// Reads a label volume, NIfTI-1/-2 or NRRD (told apart by content), in the body frame
 /// the lattice builder slices in ([`crate::LabelVolume::in_frame`]: a scan saved in
@@ -32,7 +32,7 @@ pub fn read_label_volume(
     }
 }
 
-/// A label volume (NIfTI-1 or NRRD) and what its labels mean: the label table or tool's
+/// A label volume (NIfTI-1/-2 or NRRD) and what its labels mean: the label table or tool's
 /// label list at `labels` ([`crate::LabelTable::from_path_with`]), or else the segment
 /// names a 3D Slicer segmentation carries, mapped onto known structures as `mapping`
 /// says (an [`crate::label_names::Unmapped`] rule, or a
@@ -101,7 +101,7 @@ pub fn read_input(
                      leave the label file out",
                 ));
             }
-            read_png_stack(folder, Some(&manifest))
+            read_png_stack_with(folder, Some(&manifest), mapping)
         }
         InputKind::Scenario => Err(crate::Error::parse(
             path,

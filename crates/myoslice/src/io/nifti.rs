@@ -1,8 +1,8 @@
 //! NIfTI label volumes (`.nii`, `.nii.gz`), versions 1 and 2.
 //!
 //! Reads single-file NIfTI-1 (`n+1`) and NIfTI-2 (`n+2`) in either byte order,
-//! gzip-compressed or not, with labels stored as any integer type (values 0 to 65 535) or
-//! as floats holding whole numbers (as some pipelines save label maps). The
+//! gzip-compressed or not, with labels stored as any integer type of 8 to 32 bits (values
+//! 0 to 65 535) or as floats holding whole numbers (as some pipelines save label maps). The
 //! voxel-to-world affine comes from the sform when present, else the qform, else the
 //! voxel sizes; spatial units are converted to mm.
 //!

@@ -83,6 +83,16 @@ pub fn read_png_stack(
     folder: impl AsRef<Path>,
     manifest: Option<&Path>,
 ) -> Result<(LabelVolume, LabelTable)> {
+    read_png_stack_with(folder, manifest, crate::label_names::Unmapped::Error)
+}
+
+/// [`read_png_stack`], a tool's label list named by the manifest's `labels_file` read as
+/// `mapping` says (the user's names file, what becomes of unknown names).
+pub fn read_png_stack_with(
+    folder: impl AsRef<Path>,
+    manifest: Option<&Path>,
+    mapping: impl Into<crate::label_mapping::LabelMapping>,
+) -> Result<(LabelVolume, LabelTable)> {
     let folder = folder.as_ref();
     let mpath = manifest.map_or_else(|| folder.join("manifest.toml"), Path::to_path_buf);
     let text = std::fs::read_to_string(&mpath).map_err(|e| Error::io(&mpath, e))?;
@@ -91,7 +101,9 @@ pub fn read_png_stack(
         reason: e.to_string(),
     })?;
     let table = match (&m.labels_file, &m.labels) {
-        (Some(f), None) => LabelTable::from_path(mpath.parent().unwrap_or(folder).join(f))?,
+        (Some(f), None) => {
+            LabelTable::from_path_with(mpath.parent().unwrap_or(folder).join(f), mapping)?
+        }
         (None, Some(t)) => {
             let mut wrap = toml::Table::new();
             wrap.insert("labels".into(), toml::Value::Table(t.clone()));

@@ -197,12 +197,18 @@ impl LabelVolume {
         let total = dims
             .iter()
             .try_fold(1usize, |acc, &d| acc.checked_mul(d))
-            .filter(|&n| n > 0 && n <= MAX_GROWTH.saturating_mul(self.data.len()).max(1 << 20))
+            .filter(|&n| {
+                n > 0
+                    && n <= MAX_GROWTH.saturating_mul(self.data.len()).max(1 << 20)
+                    && (n as u64).saturating_mul(2) <= crate::io::MAX_VOLUME_BYTES
+            })
             .ok_or_else(|| {
                 Error::Build(format!(
                     "resampling the oblique volume {:?} into the body frame would take \
-                     {dims:?} voxels, more than {MAX_GROWTH} times its own",
-                    self.dims
+                     {dims:?} voxels, more than {MAX_GROWTH} times its own or the \
+                     {}-byte cap on a label volume",
+                    self.dims,
+                    crate::io::MAX_VOLUME_BYTES
                 ))
             })?;
         let step: [nalgebra::Vector3<f64>; 3] = std::array::from_fn(|r| {

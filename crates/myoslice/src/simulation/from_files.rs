@@ -13,8 +13,8 @@ impl Simulation {
         Self::new(lattice, config, &MuscleCatalogue::default())
     }
 
-    /// A label volume (NIfTI-1 or NRRD) and its label table or a tool's label list (unknown
-    /// names are an error).
+    /// A label volume (NIfTI-1/-2 or NRRD) and its label table or a tool's label list
+    /// (unknown names are an error).
     pub fn from_nifti(
         volume: impl AsRef<std::path::Path>,
         labels: impl AsRef<std::path::Path>,
@@ -30,7 +30,7 @@ impl Simulation {
         )
     }
 
-    /// A label volume (NIfTI-1 or NRRD) with the meaning of its labels: a label table or
+    /// A label volume (NIfTI-1/-2 or NRRD) with the meaning of its labels: a label table or
     /// a tool's label list at `labels`, or, when None, the segment names of a 3D Slicer
     /// segmentation (see [`crate::io::read_segmentation`]).
     pub fn from_segmentation(
