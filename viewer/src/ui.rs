@@ -103,6 +103,10 @@ pub struct UiState {
     pub open_volume: String,
     /// Label table path of the form.
     pub open_labels: String,
+    /// The user's names file (TOML) of the form.
+    pub open_names: String,
+    /// What the form takes unknown label names as.
+    pub open_unmapped: Unmapped,
     /// The model shown.
     pub source: ModelSource,
 }
@@ -125,6 +129,8 @@ impl Default for UiState {
             sim_ms: 0.0,
             open_volume: String::new(),
             open_labels: String::new(),
+            open_names: String::new(),
+            open_unmapped: Unmapped::Error,
             source: ModelSource::Phantom,
         }
     }
@@ -528,13 +534,27 @@ impl UiState {
                     ui.text_edit_singleline(&mut self.open_labels);
                 });
                 ui.horizontal(|ui| {
+                    ui.label("names");
+                    ui.text_edit_singleline(&mut self.open_names);
+                });
+                ui.horizontal(|ui| {
+                    ui.label("unknown names");
+                    for (rule, text) in [
+                        (Unmapped::Error, "refuse"),
+                        (Unmapped::Fat, "fat"),
+                        (Unmapped::Ignore, "background"),
+                    ] {
+                        ui.radio_value(&mut self.open_unmapped, rule, text);
+                    }
+                });
+                ui.horizontal(|ui| {
                     if ui.button("Load volume").clicked() {
-                        let labels = self.open_labels.trim();
+                        let path = |s: &str| (!s.trim().is_empty()).then(|| s.trim().into());
                         actions.push(UiAction::Load(ModelSource::Volume {
                             volume: self.open_volume.trim().into(),
-                            labels: (!labels.is_empty()).then(|| labels.into()),
-                            names: None,
-                            unmapped: Unmapped::Error,
+                            labels: path(&self.open_labels),
+                            names: path(&self.open_names),
+                            unmapped: self.open_unmapped,
                         }));
                     }
                     if ui.button("Phantom").clicked() {

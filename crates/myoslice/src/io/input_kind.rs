@@ -85,7 +85,9 @@ impl InputKind {
                     .iter()
                     .any(|e| n.ends_with(e))
             });
-        if named_volume || head.contains(&0) || std::str::from_utf8(&head).is_err() {
+        // Text cut inside a character at the 4 KiB mark is still text.
+        let binary = std::str::from_utf8(&head).is_err_and(|e| e.error_len().is_some());
+        if named_volume || head.contains(&0) || binary {
             return Ok(Self::Volume);
         }
         Err(Error::parse(
