@@ -17,18 +17,13 @@ pub(crate) fn mapping(
     unmapped: &str,
     names: Option<&Path>,
 ) -> PyResult<LabelMapping> {
-    let rule = match unmapped {
-        "error" => Unmapped::Error,
-        "fat" => Unmapped::Fat,
-        "ignore" => Unmapped::Ignore,
-        other => {
-            return Err(myoslice::Error::InvalidValue {
-                name: "unmapped".into(),
-                value: format!("'{other}'"),
-                expected: "\"error\", \"fat\" or \"ignore\"".into(),
-            })
-            .or_py(py);
-        }
+    let Some(rule) = Unmapped::parse(unmapped) else {
+        return Err(myoslice::Error::InvalidValue {
+            name: "unmapped".into(),
+            value: format!("'{unmapped}'"),
+            expected: "\"error\", \"fat\" or \"ignore\"".into(),
+        })
+        .or_py(py);
     };
     let m = LabelMapping::new(rule);
     match names {

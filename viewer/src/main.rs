@@ -89,11 +89,11 @@ fn source(args: &Args) -> Result<ModelSource> {
     let Some(volume) = &args.volume else {
         return Ok(ModelSource::Phantom);
     };
-    let unmapped = match args.unmapped.as_str() {
-        "error" => Unmapped::Error,
-        "fat" => Unmapped::Fat,
-        "ignore" => Unmapped::Ignore,
-        other => bail!("unknown --unmapped '{other}': use error, fat or ignore"),
+    let Some(unmapped) = Unmapped::parse(&args.unmapped) else {
+        bail!(
+            "unknown --unmapped '{}': use error, fat or ignore",
+            args.unmapped
+        );
     };
     Ok(ModelSource::Volume {
         volume: volume.clone(),

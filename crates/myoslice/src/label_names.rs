@@ -196,6 +196,19 @@ pub enum Unmapped {
     Ignore,
 }
 
+impl Unmapped {
+    /// The rule by its name: `error`, `fat` or `ignore` (as the CLI, the viewer, Python
+    /// and scenarios spell it).
+    pub fn parse(name: &str) -> Option<Self> {
+        Some(match name {
+            "error" => Self::Error,
+            "fat" => Self::Fat,
+            "ignore" => Self::Ignore,
+            _ => return None,
+        })
+    }
+}
+
 /// How one label was read.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MappedLabel {

@@ -300,7 +300,7 @@ impl Scenario {
                     }
                 }
                 if let Some(u) = &raw.model.unmapped
-                    && parse_unmapped(u).is_none()
+                    && crate::label_names::Unmapped::parse(u).is_none()
                 {
                     return Err(err(format!(
                         "model.unmapped = \"{u}\"{}: expected \"error\", \"fat\" or \"ignore\"",
@@ -382,7 +382,7 @@ impl Scenario {
                     .model
                     .unmapped
                     .as_deref()
-                    .and_then(parse_unmapped)
+                    .and_then(crate::label_names::Unmapped::parse)
                     .unwrap_or_default();
                 let mut mapping = crate::label_mapping::LabelMapping::new(unmapped);
                 if let Some(n) = &self.model.names {
@@ -462,16 +462,6 @@ pub fn group_members(sim: &Simulation, name: &str) -> Vec<String> {
         "all" => pick(&|_| true),
         n => pick(&|m| m.name == n),
     }
-}
-
-fn parse_unmapped(s: &str) -> Option<crate::label_names::Unmapped> {
-    use crate::label_names::Unmapped;
-    Some(match s {
-        "error" => Unmapped::Error,
-        "fat" => Unmapped::Fat,
-        "ignore" => Unmapped::Ignore,
-        _ => return None,
-    })
 }
 
 fn resolve(scenario: &Path, p: &Path) -> PathBuf {

@@ -49,7 +49,10 @@ impl InputKind {
         std::fs::File::open(path)
             .and_then(|f| f.take(4096).read_to_end(&mut head))
             .map_err(|e| Error::io(path, e))?;
-        if head.starts_with(&[0x1f, 0x8b]) || super::is_nrrd(&head) || is_nifti_header(&head) {
+        if head.starts_with(&[0x1f, 0x8b])
+            || super::is_nrrd(&head)
+            || super::nifti::header_len(&head).is_some()
+        {
             return Ok(Self::Volume);
         }
         // Text: a scenario or a PNG stack's manifest, by their keys. Only the start was
@@ -96,15 +99,6 @@ impl InputKind {
              manifest nor a scenario",
         ))
     }
-}
-
-/// A NIfTI-1 (348) or NIfTI-2 (540) header size in either byte order.
-fn is_nifti_header(b: &[u8]) -> bool {
-    let Some(h) = b.get(..4) else { return false };
-    let h = [h[0], h[1], h[2], h[3]];
-    [i32::from_le_bytes(h), i32::from_be_bytes(h)]
-        .iter()
-        .any(|&n| n == 348 || n == 540)
 }
 
 #[cfg(test)]

@@ -95,7 +95,7 @@ fn too_big(claimed: u64) -> String {
 
 /// The header's size by its `sizeof_hdr` (348: NIfTI-1, 540: NIfTI-2) and whether it is
 /// big-endian.
-fn header_len(b: &[u8]) -> Option<(usize, bool)> {
+pub(crate) fn header_len(b: &[u8]) -> Option<(usize, bool)> {
     let h: [u8; 4] = b.get(..4)?.try_into().ok()?;
     [
         (NIFTI1_LEN, false),
