@@ -3,7 +3,8 @@
 # off-screen viewer capture, Xvfb for the window's smoke test), Rust format/lint/tests,
 # then the Python package built as a wheel into a fresh virtual environment and its
 # pytest suite (bindings, Gymnasium env, stubs, scenario runs and their ParaView/Blender
-# outputs).
+# outputs, sweeps on a local two-node Ray cluster, fits with Ray Tune), and RLlib's PPO
+# on the env in an environment of its own.
 # Usage: scripts/test.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -57,5 +58,14 @@ fi
 step "pytest"
 # From the repository root, so that the installed wheel (not python/myoslice/) is imported.
 .venv-test/bin/python -m pytest -q python/tests
+
+step "RLlib (its own environment: RLlib pins an older gymnasium)"
+rm -rf .venv-rllib
+python3 -m venv .venv-rllib
+.venv-rllib/bin/python -m pip install -q --upgrade pip
+.venv-rllib/bin/python -m pip install -q -r python/requirements-rllib.txt
+.venv-rllib/bin/python -m pip install -q --no-deps target/wheels/myoslice-*.whl
+MYOSLICE_REQUIRE_RLLIB=1 .venv-rllib/bin/python -m pytest -q python/tests/test_rllib.py
+rm -rf .venv-rllib
 
 step "all tests passed"

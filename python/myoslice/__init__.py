@@ -23,12 +23,16 @@ With gymnasium installed, the reaching task is registered as ``"myoslice/KneeRea
     import gymnasium, myoslice
     env = gymnasium.make("myoslice/KneeReach-v0")
 
+Scenario files run with :func:`run_scenario` (as ``myoslice run`` does); many runs at once
+with :func:`myoslice.sweep.sweep` (on Ray), and muscle parameters fitted to a measured
+knee trajectory with :func:`myoslice.fit.fit` (Ray Tune).
+
 Errors all derive from :class:`MyoSliceError` (see :mod:`myoslice.errors`).
 """
 
 from __future__ import annotations
 
-from ._myoslice import Simulation, State, __version__
+from ._myoslice import Simulation, State, __version__, check_scenario, run_scenario
 from .errors import (
     InvalidInputError,
     ModelFileError,
@@ -49,6 +53,8 @@ __all__ = [
     "State",
     "UnknownNameError",
     "__version__",
+    "check_scenario",
+    "run_scenario",
 ]
 
 #: Gymnasium id of :class:`myoslice.envs.KneeReach`.

@@ -11,7 +11,7 @@ from typing import Any, TypeAlias, TypedDict, final
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["Simulation", "State", "__version__"]
+__all__ = ["Simulation", "State", "__version__", "check_scenario", "run_scenario"]
 
 _StrPath: TypeAlias = str | os.PathLike[str]
 
@@ -335,3 +335,22 @@ class Simulation:
         """
 
     def __repr__(self) -> str: ...
+
+
+def run_scenario(
+    path: _StrPath, out: _StrPath, *, text: str | None = None, reuse_model: bool = False
+) -> dict[str, Any]:
+    """Runs a scenario to its end into the folder ``out`` (``timeseries.csv``,
+    ``summary.json``, and the VTU series and GLB its ``[output]`` asks for), as
+    ``myoslice run`` does, and returns the summary as a dict. With ``text``, the scenario is
+    that TOML text and ``path`` only places its relative files and names it in errors.
+    With ``reuse_model``, the lattice of the last model built so in this process is
+    reused when the scenario's model (source, files, slicing) is the same: the same bits,
+    without the build's cost. The GIL is released while it runs."""
+
+def check_scenario(path: _StrPath, *, text: str | None = None, build: bool = False) -> None:
+    """Reads and checks a scenario (every field, range and file, and the simulation's
+    settings) without building it: raises what :func:`run_scenario` would raise before its
+    build. With ``build``, also builds its model (reusing the lattice as ``reuse_model``
+    does) so that the muscle and group names of ``[excitation]`` and ``[muscle.NAME]``
+    are checked too."""

@@ -19,13 +19,14 @@ pub(crate) type SurfaceArrays<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyAr
 pub(crate) fn metric_array<'py>(
     py: Python<'py>,
     sim: &Simulation,
-    pick: impl Fn(&TissueMetrics) -> &Vec<f32>,
+    pick: impl Fn(&TissueMetrics) -> &Vec<f32> + Send + Sync,
 ) -> Bound<'py, PyArray1<f32>> {
-    PyArray1::from_vec(
-        py,
+    // Measured on first use, in parallel: on threads of this process (crate::pool).
+    let values = crate::pool::detach(py, || {
         sim.tissue_metrics()
-            .map_or_else(Vec::new, |m| pick(m).clone()),
-    )
+            .map_or_else(Vec::new, |m| pick(m).clone())
+    });
+    PyArray1::from_vec(py, values)
 }
 
 /// How far muscles reach where they should not, as a dict of per-muscle arrays:

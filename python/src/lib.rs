@@ -4,7 +4,9 @@
 mod arrays;
 mod config;
 mod errors;
+mod pool;
 mod render;
+mod scenario_run;
 mod sources;
 
 use std::path::PathBuf;
@@ -85,13 +87,12 @@ impl PySimulation {
             chain_tether_release_n,
         }
         .config(py)?;
-        let sim = py
-            .detach(move || -> myoslice::Result<Simulation> {
-                let (v, t) = Phantom { voxel_mm }.generate()?;
-                let lat = Lattice::build(&v, &t, &BuildOptions::default())?;
-                Simulation::new(lat, c, &MuscleCatalogue::default())
-            })
-            .or_py(py)?;
+        let sim = crate::pool::detach(py, move || -> myoslice::Result<Simulation> {
+            let (v, t) = Phantom { voxel_mm }.generate()?;
+            let lat = Lattice::build(&v, &t, &BuildOptions::default())?;
+            Simulation::new(lat, c, &MuscleCatalogue::default())
+        })
+        .or_py(py)?;
         Ok(Self {
             sim,
             offscreen: None,
@@ -195,9 +196,7 @@ impl PySimulation {
     #[staticmethod]
     fn from_scenario(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
         check_path(py, &path, "scenario")?;
-        let sim = py
-            .detach(move || Scenario::from_path(&path)?.build())
-            .or_py(py)?;
+        let sim = crate::pool::detach(py, move || Scenario::from_path(&path)?.build()).or_py(py)?;
         sources::warn(py, sim.warnings())?;
         Ok(Self {
             sim,
@@ -223,7 +222,7 @@ impl PySimulation {
             ));
         }
         let sim = &mut self.sim;
-        py.detach(move || -> myoslice::Result<()> {
+        crate::pool::detach(py, move || -> myoslice::Result<()> {
             for _ in 0..n {
                 sim.step(dt)?;
             }
@@ -441,7 +440,8 @@ impl PySimulation {
     /// "bone", "muscle" or "skin".
     fn surface<'py>(&self, py: Python<'py>, layer: &str) -> PyResult<SurfaceArrays<'py>> {
         let layer: Layer = layer.parse().or_py(py)?;
-        let surface = self.sim.surface(layer);
+        let sim = &self.sim;
+        let surface = crate::pool::detach(py, move || sim.surface(layer));
         Ok((
             vec3_array(py, &surface.vertices),
             tri_array(py, &surface.triangles),
@@ -475,8 +475,9 @@ impl PySimulation {
     /// Fat elements with a folded corner now (a corner Jacobian at or below zero,
     /// ParaView's test of a valid hexahedron); 0 without tissue.
     #[getter]
-    fn folded_elements(&self) -> usize {
-        self.sim.tissue_metrics().map_or(0, |m| m.inverted)
+    fn folded_elements(&self, py: Python<'_>) -> usize {
+        let sim = &self.sim;
+        crate::pool::detach(py, || sim.tissue_metrics().map_or(0, |m| m.inverted))
     }
 
     /// What the build could not take from the muscle catalogue: one line per muscle
@@ -507,7 +508,7 @@ impl PySimulation {
     /// `vertices_over_1mm` (int64) and `deepest_m` (float32), empty without tissue.
     fn muscles_in_bone<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let sim = &self.sim;
-        let o = py.detach(|| sim.muscles_in_bone()).unwrap_or_default();
+        let o = crate::pool::detach(py, || sim.muscles_in_bone()).unwrap_or_default();
         let (count, deepest) = o.iter().map(|b| (b.vertices_over_1mm, b.deepest_m)).unzip();
         reach_dict(py, count, ("deepest_m", deepest))
     }
@@ -517,14 +518,14 @@ impl PySimulation {
     /// without tissue (or where the skin cannot be closed into a mesh).
     fn muscles_outside_skin<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let sim = &self.sim;
-        breach_dict(py, py.detach(|| sim.muscles_outside_skin()))
+        breach_dict(py, crate::pool::detach(py, || sim.muscles_outside_skin()))
     }
 
     /// How far each bone's surface reaches out through the skin now, as
     /// `muscles_outside_skin` but per bone, in `bone_names` order.
     fn bones_outside_skin<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let sim = &self.sim;
-        breach_dict(py, py.detach(|| sim.bones_outside_skin()))
+        breach_dict(py, crate::pool::detach(py, || sim.bones_outside_skin()))
     }
 
     /// Bone names, in the order of `bones_outside_skin`.
@@ -547,7 +548,8 @@ impl PySimulation {
     /// Puts the knee at `angle` (rad) with flexion `velocity` (rad/s).
     #[pyo3(signature = (angle, velocity = 0.0))]
     fn set_knee(&mut self, py: Python<'_>, angle: f64, velocity: f64) -> PyResult<()> {
-        self.sim.set_knee(angle, velocity).or_py(py)
+        let sim = &mut self.sim;
+        crate::pool::detach(py, move || sim.set_knee(angle, velocity)).or_py(py)
     }
 
     /// A checkpoint of the whole dynamic state, the muscle and tendon models included.
@@ -559,7 +561,8 @@ impl PySimulation {
 
     /// Restores a checkpoint of this simulation.
     fn set_state(&mut self, py: Python<'_>, state: &PyState) -> PyResult<()> {
-        self.sim.set_state(&state.inner).or_py(py)
+        let (sim, inner) = (&mut self.sim, &state.inner);
+        crate::pool::detach(py, move || sim.set_state(inner)).or_py(py)
     }
 
     /// Renders the leg off-screen: uint8 (height, width, 3).
@@ -598,11 +601,14 @@ impl PySimulation {
 #[pymodule]
 mod _myoslice {
     #[pymodule_export]
+    use super::scenario_run::{check_scenario, run_scenario};
+    #[pymodule_export]
     use super::{PySimulation, PyState};
 
     #[pymodule_init]
     fn init(m: &pyo3::Bound<'_, pyo3::types::PyModule>) -> pyo3::PyResult<()> {
         use pyo3::types::PyModuleMethods;
+        super::pool::note_origin();
         m.add("__version__", env!("CARGO_PKG_VERSION"))
     }
 }

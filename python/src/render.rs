@@ -75,9 +75,10 @@ pub(crate) fn render<'py>(
     let Some((_, _, off)) = offscreen.as_mut() else {
         unreachable!()
     };
-    let rgba = py
-        .detach(|| off.render(gpu, sim, &opts).map_err(|e| e.to_string()))
-        .map_err(|e| py_err(py, Kind::Renderer, e))?;
+    let rgba = crate::pool::detach(py, || {
+        off.render(gpu, sim, &opts).map_err(|e| e.to_string())
+    })
+    .map_err(|e| py_err(py, Kind::Renderer, e))?;
     let rgb: Vec<u8> = rgba
         .chunks_exact(4)
         .flat_map(|p| [p[0], p[1], p[2]])

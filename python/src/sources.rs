@@ -49,8 +49,10 @@ pub(crate) fn simulation_from_file(
     if let Some(labels) = &labels {
         check_path(py, labels, "label table")?;
     }
-    py.detach(move || Simulation::from_file(&path, labels.as_deref(), mapping, &build, config))
-        .or_py(py)
+    crate::pool::detach(py, move || {
+        Simulation::from_file(&path, labels.as_deref(), mapping, &build, config)
+    })
+    .or_py(py)
 }
 
 /// Whether `path` holds a scenario rather than a volume or PNG stack.

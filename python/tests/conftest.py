@@ -4,6 +4,7 @@ tissue) is built once per session and tests get it back at its initial state thr
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator
 
 import numpy as np
@@ -17,6 +18,12 @@ except ImportError as e:  # pragma: no cover - setup problem
         "`cd python && maturin develop`), and run pytest from the repository root so that "
         "the source folder python/myoslice (without the compiled module) does not shadow it."
     ) from e
+
+# Ray (sweeps, fits) on this machine's loopback interface only: Ray's switch for machines
+# that are not cluster hosts, which makes every node, the test cluster's too, use
+# 127.0.0.1. Set before Ray is imported.
+os.environ.setdefault("RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER", "0")
+
 
 def _restored(built: tuple[Simulation, State]) -> Simulation:
     sim, initial = built

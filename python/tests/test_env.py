@@ -248,3 +248,32 @@ def test_close_is_idempotent() -> None:
     env.close()
     with pytest.raises(gymnasium.error.ClosedEnvironmentError):
         env.unwrapped.step(np.zeros(env.action_space.shape, dtype=np.float32))
+
+
+@pytest.mark.parametrize("mode", ["sync", "async"])
+def test_make_vec_runs_the_same_episodes_as_single_envs(mode: str) -> None:
+    """``gymnasium.make_vec`` works in both modes (async forks worker processes, whose
+    parallel loops get threads of their own) and each sub-environment follows the
+    single environment step for step."""
+    actions = np.full((3, 2, 13), 0.4, dtype=np.float32)
+    actions[:, 1] = 0.1
+    vec = gymnasium.make_vec(ENV_ID, num_envs=2, vectorization_mode=mode)
+    try:
+        obs, _ = vec.reset(seed=[5, 6])
+        seen = [obs]
+        for a in actions:
+            obs, _, _, _, _ = vec.step(a)
+            seen.append(obs)
+    finally:
+        vec.close()
+    for i, seed in enumerate((5, 6)):
+        env = gymnasium.make(ENV_ID)
+        try:
+            o, _ = env.reset(seed=seed)
+            mine = [o]
+            for a in actions:
+                o, _, _, _, _ = env.step(a[i])
+                mine.append(o)
+        finally:
+            env.close()
+        np.testing.assert_array_equal(np.array([s[i] for s in seen]), np.array(mine))

@@ -9,6 +9,7 @@ use myoslice::BuildReport;
 
 mod bench;
 mod labels;
+mod sweep;
 use myoslice::prelude::*;
 
 #[derive(Parser)]
@@ -39,6 +40,10 @@ enum Command {
     /// Show how a label table or a segmentation tool's label list (ITK-SNAP, 3D Slicer)
     /// reads: each label's name and the structure it maps to.
     Labels(labels::LabelsArgs),
+    /// Run a sweep file's runs (a parameter study) on Ray or one after another, into one
+    /// Parquet table; runs the Python package (`python3 -m myoslice sweep`, or the
+    /// interpreter in MYOSLICE_PYTHON), which needs ray and pyarrow.
+    Sweep(sweep::SweepArgs),
 }
 
 #[derive(Args)]
@@ -284,7 +289,6 @@ fn build(args: &BuildArgs) -> Result<()> {
 }
 
 fn run_scenario(a: &RunArgs) -> Result<()> {
-    use myoslice::export::{RunOutputs, RunWriter};
     let mut sc = Scenario::from_path(&a.scenario)?;
     if let Some(d) = a.duration {
         anyhow::ensure!(
@@ -293,46 +297,30 @@ fn run_scenario(a: &RunArgs) -> Result<()> {
         );
         sc.simulation.duration_s = d;
     }
-    let t0 = Instant::now();
-    let mut sim = sc.build()?;
-    for w in sim.warnings() {
-        eprintln!("warning: {w}");
-    }
-    let outputs = RunOutputs {
-        vtu: sc.output.vtu,
-        glb: sc.output.glb,
-    };
-    let mut w = RunWriter::create(&a.out, &sim, outputs)?;
-    let duration = sc.simulation.duration_s;
-    let dt = sc.simulation.step_s;
-    let steps = (duration / dt).round().max(1.0) as u64;
-    let frames = sc.output.frames.max(1) as u64;
-    let row_every = ((0.01 / dt).round() as u64).max(1);
     let bar = if a.quiet {
         indicatif::ProgressBar::hidden()
     } else {
-        indicatif::ProgressBar::new(steps)
+        indicatif::ProgressBar::new(0)
     };
     bar.set_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} steps  {msg}  eta {eta}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    let mut next_frame = 1;
-    for k in 1..=steps {
-        sim.step(dt)?;
-        if k % row_every == 0 || k == steps {
-            w.row(&sim)?;
+    let mut warned = false;
+    let summary = myoslice::export::run_scenario(&sc, &a.out, &mut |p| {
+        if !warned {
+            for w in p.sim.warnings() {
+                bar.suspend(|| eprintln!("warning: {w}"));
+            }
+            bar.set_length(p.steps);
+            warned = true;
         }
-        if k * frames >= next_frame * steps {
-            sim.update_tissue()?;
-            w.frame(&sim)?;
-            next_frame += 1;
-            bar.set_message(format!("knee {:.1}°", sim.knee_angle().to_degrees()));
+        bar.set_position(p.step);
+        if p.step % 50 == 0 {
+            bar.set_message(format!("knee {:.1}°", p.sim.knee_angle().to_degrees()));
         }
-        bar.inc(1);
-    }
+    })?;
     bar.finish_and_clear();
-    let summary = w.finish(&sim, t0.elapsed().as_secs_f64())?;
     if !a.quiet {
         println!(
             "{:.2} s simulated in {:.2} s ({:.2}x real time; muscles {:.2} s, tissue {:.2} s): knee {:.1}..{:.1}°, {} frames -> {}",
@@ -412,6 +400,7 @@ fn run(cli: &Cli) -> Result<()> {
     match &cli.command {
         Command::Build(a) => build(a),
         Command::Run(a) => run_scenario(a),
+        Command::Sweep(a) => sweep::run(a),
         Command::Bench(a) => bench::run(&bench::BenchOptions {
             json: a.json,
             visible_human: a.visible_human.as_deref(),

@@ -22,12 +22,18 @@
 //! initial_knee_deg = 0.0      # default 0
 //! chain_tether = 600.0        # N/m pulling relaxed chains to rest, 0 = off (default 600)
 //! chain_tether_release_n = 20.0  # muscle force (N) where the tether lets go (default 20)
+//! excitation_scale = 1.0      # factor on every [excitation] value (capped at 1), default 1
 //!
 //! [tissue]                    # every TissueConfig field, all optional
 //! rate_hz = 30.0
 //!
 //! [excitation]                # per muscle or group: [[time s, value], ...]
 //! hamstrings = [[0.0, 0.0], [0.2, 0.6]]
+//!
+//! [muscle.hamstrings]         # per muscle or group, factors on the catalogue's values
+//! max_force_scale = 1.0       # all default 1, each 0.05 to 20
+//! optimal_fibre_length_scale = 1.0
+//! tendon_slack_length_scale = 1.0
 //!
 //! [output]
 //! frames = 30                 # output frames over the run (default 25)
@@ -44,7 +50,7 @@ use serde::Deserialize;
 
 use crate::error::{Error, Result};
 use crate::lattice::BuildOptions;
-use crate::muscle::MuscleGroup;
+use crate::muscle::{MuscleGroup, MuscleScale};
 use crate::simulation::{MuscleModel, Schedule, Simulation, SimulationConfig, TendonModel};
 use crate::slices::SliceReduction;
 use crate::tissue::TissueConfig;
@@ -143,10 +149,16 @@ pub struct SimulationSection {
     /// ([`SimulationConfig::chain_tether_release_n`]); its default when absent.
     #[serde(default)]
     pub chain_tether_release_n: Option<f64>,
+    /// Factor on every excitation schedule's values (capped at 1); 1 when absent.
+    #[serde(default = "one")]
+    pub excitation_scale: f64,
 }
 
 fn default_model() -> MuscleModel {
     MuscleModel::Hill
+}
+fn one() -> f64 {
+    1.0
 }
 fn default_dt() -> f64 {
     1e-3
@@ -187,6 +199,8 @@ struct RawScenario {
     #[serde(default)]
     excitation: BTreeMap<String, Vec<(f64, f64)>>,
     #[serde(default)]
+    muscle: BTreeMap<String, MuscleScale>,
+    #[serde(default)]
     output: OutputSection,
 }
 
@@ -203,8 +217,11 @@ pub struct Scenario {
     pub simulation: SimulationSection,
     /// Tissue options.
     pub tissue: TissueConfig,
-    /// Excitation schedules by muscle or group name.
+    /// Excitation schedules by muscle or group name (already scaled by
+    /// `simulation.excitation_scale`).
     pub excitation: BTreeMap<String, Schedule>,
+    /// Factors on the catalogued parameters by muscle or group name.
+    pub muscle: BTreeMap<String, MuscleScale>,
     /// Outputs.
     pub output: OutputSection,
     text: String,
@@ -244,6 +261,18 @@ impl Scenario {
                 s.step_s,
                 line_of("step_s")
             )));
+        }
+        if !(s.excitation_scale.is_finite() && (0.0..=10.0).contains(&s.excitation_scale)) {
+            return Err(err(format!(
+                "simulation.excitation_scale = {}{}: expected 0 to 10",
+                s.excitation_scale,
+                line_of("excitation_scale")
+            )));
+        }
+        for (name, scale) in &raw.muscle {
+            scale
+                .check(name)
+                .map_err(|e| err(format!("{e}{}", line_of(&format!("[muscle.{name}]")))))?;
         }
         for (key, value) in [
             ("chain_tether", s.chain_tether),
@@ -315,8 +344,23 @@ impl Scenario {
                 )));
             }
         }
+        if raw.output.frames > 100_000 {
+            return Err(err(format!(
+                "output.frames = {}{}: expected at most 100000",
+                raw.output.frames,
+                line_of("frames")
+            )));
+        }
         let mut excitation = BTreeMap::new();
+        let gain = raw.simulation.excitation_scale;
         for (name, pts) in raw.excitation {
+            // Checked as written, then scaled: a bad value is named as the user wrote it.
+            Schedule::new(pts.clone())
+                .map_err(|e| err(format!("excitation.{name}{}: {e}", line_of(&name))))?;
+            let pts = pts
+                .into_iter()
+                .map(|(t, v)| (t, (v * gain).min(1.0)))
+                .collect();
             let sched = Schedule::new(pts)
                 .map_err(|e| err(format!("excitation.{name}{}: {e}", line_of(&name))))?;
             excitation.insert(name, sched);
@@ -328,6 +372,7 @@ impl Scenario {
             simulation: raw.simulation,
             tissue: raw.tissue,
             excitation,
+            muscle: raw.muscle,
             output: raw.output,
             text: text.to_string(),
         })
@@ -365,13 +410,29 @@ impl Scenario {
 
     /// Builds the simulation with its schedules applied.
     pub fn build(&self) -> Result<Simulation> {
-        let err = |reason: String| Error::Parse {
-            path: self.path.clone(),
-            reason,
-        };
+        self.check()?;
+        self.build_on(self.lattice()?)
+    }
+
+    /// Checks the simulation settings it describes (as [`Self::build`] does first, before
+    /// the slow part).
+    pub fn check(&self) -> Result<()> {
+        self.checked_config().map(|_| ())
+    }
+
+    fn checked_config(&self) -> Result<SimulationConfig> {
         let config = self.config();
-        config.validate().map_err(|e| err(e.to_string()))?;
-        let mut sim = match self.model.source.as_str() {
+        config.validate().map_err(|e| Error::Parse {
+            path: self.path.clone(),
+            reason: e.to_string(),
+        })?;
+        Ok(config)
+    }
+
+    /// The lattice of its model (the slow part of [`Self::build`]): the phantom's, or the
+    /// label volume's read with its labels and names.
+    pub fn lattice(&self) -> Result<crate::lattice::Lattice> {
+        let (volume, table) = match self.model.source.as_str() {
             "nifti" => {
                 let v = resolve(
                     &self.path,
@@ -388,46 +449,110 @@ impl Scenario {
                 if let Some(n) = &self.model.names {
                     mapping = mapping.with_names_file(resolve(&self.path, n))?;
                 }
-                Simulation::from_file(v, l.as_deref(), mapping, &self.build_options(), config)?
+                crate::io::read_input(v, l.as_deref(), mapping)?
             }
-            _ => {
-                let (volume, table) = crate::phantom::Phantom::default().generate()?;
-                let lattice =
-                    crate::lattice::Lattice::build(&volume, &table, &self.build_options())?;
-                Simulation::new(lattice, config, &crate::muscle::MuscleCatalogue::default())?
-            }
+            _ => crate::phantom::Phantom::default().generate()?,
         };
+        crate::lattice::Lattice::build(&volume, &table, &self.build_options())
+    }
+
+    /// What [`Self::lattice`] depends on, as text: two scenarios with the same key build
+    /// the same lattice (their other sections may differ), so a lattice built for one
+    /// serves the other (sweeps build each model once per process).
+    pub fn lattice_key(&self) -> String {
+        let m = &self.model;
+        // Each file by its full path, size and modification time: an edited file is a
+        // new model.
+        let file = |p: &Option<PathBuf>| {
+            p.as_ref().map(|p| {
+                let full = resolve(&self.path, p);
+                let full = std::fs::canonicalize(&full).unwrap_or(full);
+                let meta = std::fs::metadata(&full).ok();
+                (
+                    full,
+                    meta.as_ref().map(std::fs::Metadata::len),
+                    meta.and_then(|m| m.modified().ok()),
+                )
+            })
+        };
+        format!(
+            "{}|{:?}|{:?}|{:?}|{:?}|{:?}",
+            m.source,
+            file(&m.volume),
+            file(&m.labels),
+            file(&m.names),
+            m.unmapped,
+            self.build_options()
+        )
+    }
+
+    /// Builds the simulation on a lattice of its model ([`Self::lattice`], perhaps kept
+    /// from an earlier build with the same [`Self::lattice_key`]), with its schedules and
+    /// muscle factors applied.
+    pub fn build_on(&self, lattice: crate::lattice::Lattice) -> Result<Simulation> {
+        let config = self.checked_config()?;
+        let mut sim = Simulation::new(lattice, config, &crate::muscle::MuscleCatalogue::default())?;
         self.apply_schedules(&mut sim)?;
         Ok(sim)
     }
 
-    /// Applies the excitation schedules to a simulation (checking every name).
+    /// Applies the excitation schedules and the muscles' parameter factors to a
+    /// simulation (checking every name).
+    ///
+    /// The broader name first, the narrower after it, whatever their order in the file:
+    /// `all`, then `flexors` and `extensors`, then `hamstrings` and `quadriceps`, then
+    /// single muscles, so that `[muscle.semitendinosus]` overrides `[muscle.hamstrings]`
+    /// for that muscle.
     pub fn apply_schedules(&self, sim: &mut Simulation) -> Result<()> {
-        for (name, sched) in &self.excitation {
-            let targets = group_members(sim, name);
-            if targets.is_empty() {
-                let known: Vec<&str> = sim.muscle_names();
-                let e = Error::unknown_name(
-                    "muscle or group",
-                    name,
-                    known.into_iter().chain(GROUPS.iter().copied()),
-                );
-                let line = self
-                    .text
-                    .lines()
-                    .position(|l| l.trim_start().starts_with(name.as_str()))
-                    .map_or(String::new(), |n| format!(" (line {})", n + 1));
-                return Err(Error::Parse {
-                    path: self.path.clone(),
-                    reason: format!("excitation.{name}{line}: {e}"),
-                });
-            }
-            for m in targets {
+        for (name, sched) in by_breadth(&self.excitation) {
+            for m in self.members(sim, "excitation", name)? {
                 sim.set_schedule(&m, sched.clone())?;
+            }
+        }
+        for (name, scale) in by_breadth(&self.muscle) {
+            for m in self.members(sim, "muscle", name)? {
+                sim.scale_muscle(&m, scale)?;
             }
         }
         Ok(())
     }
+
+    /// The muscles `name` (a muscle or group) stands for, in the error naming section and
+    /// line when none.
+    fn members(&self, sim: &Simulation, section: &str, name: &str) -> Result<Vec<String>> {
+        let targets = group_members(sim, name);
+        if !targets.is_empty() {
+            return Ok(targets);
+        }
+        let known: Vec<&str> = sim.muscle_names();
+        let e = Error::unknown_name(
+            "muscle or group",
+            name,
+            known.into_iter().chain(GROUPS.iter().copied()),
+        );
+        let line = self
+            .text
+            .lines()
+            .position(|l| l.contains(name))
+            .map_or(String::new(), |n| format!(" (line {})", n + 1));
+        Err(Error::Parse {
+            path: self.path.clone(),
+            reason: format!("{section}.{name}{line}: {e}"),
+        })
+    }
+}
+
+/// Entries from the broadest group to single muscles (name order within a rank).
+fn by_breadth<T>(entries: &BTreeMap<String, T>) -> Vec<(&str, &T)> {
+    let rank = |n: &str| match n {
+        "all" => 0,
+        "flexors" | "extensors" => 1,
+        "hamstrings" | "quadriceps" => 2,
+        _ => 3,
+    };
+    let mut v: Vec<(&str, &T)> = entries.iter().map(|(k, t)| (k.as_str(), t)).collect();
+    v.sort_by_key(|(k, _)| rank(k));
+    v
 }
 
 /// Group names scenarios accept.
@@ -541,6 +666,51 @@ mod tests {
             e.contains("simulation.chain_tether = NaN") && e.contains("line 3"),
             "{e}"
         );
+    }
+
+    #[test]
+    fn excitation_scale_multiplies_every_schedule_and_caps_at_one() {
+        let s = parse(
+            "[simulation]\nduration_s = 1\nexcitation_scale = 1.5\n[excitation]\nhamstrings = [[0.0, 0.4], [0.2, 0.8]]\n",
+        )
+        .unwrap();
+        assert_eq!(
+            s.excitation["hamstrings"].points(),
+            &[(0.0, 0.4 * 1.5), (0.2, 1.0)]
+        );
+        let e = parse("[simulation]\nduration_s = 1\nexcitation_scale = -1\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("excitation_scale = -1") && e.contains("line 3"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn muscle_factors_are_read_per_name_and_checked() {
+        let s = parse("[simulation]\nduration_s = 1\n[muscle.hamstrings]\nmax_force_scale = 1.5\n")
+            .unwrap();
+        let f = s.muscle["hamstrings"];
+        assert_eq!(
+            (
+                f.max_force_scale,
+                f.optimal_fibre_length_scale,
+                f.tendon_slack_length_scale
+            ),
+            (1.5, 1.0, 1.0)
+        );
+        let e = parse("[simulation]\nduration_s = 1\n[muscle.hamstrings]\nmax_force_scale = 0\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("muscle.hamstrings.max_force_scale") && e.contains("line 3"),
+            "{e}"
+        );
+        let e = parse("[simulation]\nduration_s = 1\n[muscle.hamstrings]\nforce = 2\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("force"), "{e}");
     }
 
     #[test]

@@ -49,6 +49,7 @@ impl MuscleSnapshot {
                 lattice_index: _,
                 group: _,
                 hill: _,
+                built_hill: _,
                 chain: c,
                 crosses_knee: _,
                 mass: _,

@@ -47,6 +47,8 @@ pub struct MuscleUnit {
     pub group: MuscleGroup,
     /// Hill parameters, lengths scaled to this model.
     pub hill: HillParams,
+    /// The Hill parameters as built, before any [`crate::muscle::MuscleScale`].
+    pub built_hill: HillParams,
     /// The chain.
     pub chain: MuscleChain,
     /// Whether origin and insertion are on different bodies (it moves the knee).
@@ -86,6 +88,7 @@ impl Clone for MuscleUnit {
             lattice_index: self.lattice_index,
             group: self.group,
             hill: self.hill,
+            built_hill: self.built_hill,
             chain: self.chain.clone(),
             crosses_knee: self.crosses_knee,
             mass: self.mass,
@@ -111,6 +114,7 @@ impl Clone for MuscleUnit {
             lattice_index,
             group,
             hill,
+            built_hill,
             chain,
             crosses_knee,
             mass,
@@ -129,7 +133,8 @@ impl Clone for MuscleUnit {
         self.name.clone_from(name);
         self.bones.clone_from(bones);
         self.chain.clone_from(chain);
-        (self.lattice_index, self.group, self.hill) = (*lattice_index, *group, *hill);
+        (self.lattice_index, self.group) = (*lattice_index, *group);
+        (self.hill, self.built_hill) = (*hill, *built_hill);
         (self.crosses_knee, self.mass, self.from_catalogue) =
             (*crosses_knee, *mass, *from_catalogue);
         (self.excitation, self.activation, self.force) = (*excitation, *activation, *force);
@@ -459,6 +464,7 @@ impl MuscleUnit {
             lattice_index: index,
             group: r.group,
             hill,
+            built_hill: hill,
             chain,
             crosses_knee,
             mass,

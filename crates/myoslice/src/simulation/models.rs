@@ -2,6 +2,7 @@
 
 use super::{MuscleModel, Simulation, TendonModel};
 use crate::error::Result;
+use crate::muscle::MuscleScale;
 
 impl Simulation {
     /// The muscle model driving the chains now.
@@ -80,6 +81,30 @@ impl Simulation {
             self.muscles[i].tendon = tendon;
             self.start_fibre(i);
         }
+    }
+
+    /// Multiplies one muscle's Hill parameters by `scale` (maximum force, optimal fibre
+    /// length, tendon slack length), from the values it was built with: calling it twice
+    /// does not compound. The fibre restarts as [`Self::set_tendon_model`] starts it.
+    ///
+    /// ```no_run
+    /// use myoslice::muscle::MuscleScale;
+    /// use myoslice::prelude::*;
+    /// let mut sim = Simulation::phantom(SimulationConfig::default())?;
+    /// let stronger = MuscleScale { max_force_scale: 1.5, ..MuscleScale::default() };
+    /// sim.scale_muscle("semitendinosus", &stronger)?;
+    /// # Ok::<(), myoslice::Error>(())
+    /// ```
+    pub fn scale_muscle(&mut self, name: &str, scale: &MuscleScale) -> Result<()> {
+        let i = self.muscle_index(name)?;
+        scale.check(name)?;
+        let m = &mut self.muscles[i];
+        let built = m.built_hill;
+        m.hill.max_isometric_force = built.max_isometric_force * scale.max_force_scale;
+        m.hill.optimal_fibre_length = built.optimal_fibre_length * scale.optimal_fibre_length_scale;
+        m.hill.tendon_slack_length = built.tendon_slack_length * scale.tendon_slack_length_scale;
+        self.start_fibre(i);
+        Ok(())
     }
 
     /// Every fibre in the state the current models give it at the current path (see
