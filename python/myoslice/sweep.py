@@ -132,8 +132,8 @@ def _write_atomic(path: Path, text: str) -> None:
 class _Progress:
     """A one-line progress display with an ETA, on stderr."""
 
-    def __init__(self, total: int, done: int, show: bool) -> None:
-        self.total, self.done, self.failed = total, done, 0
+    def __init__(self, total: int, done: int, failed: int, show: bool) -> None:
+        self.total, self.done, self.failed = total, done, failed
         self.start, self.first = time.monotonic(), done
         self.show = show
         self._draw()
@@ -188,16 +188,18 @@ def _open_folder(plan: SweepPlan, out: Path) -> None:
         _write_atomic(manifest, json.dumps(doc, indent=1))
 
 
-def _done(out: Path, run: Run, retry_failed: bool) -> bool:
-    path = out / "runs" / run.id / "row.json"
-    if not path.exists():
-        return False
-    if not retry_failed:
-        return True
+def _row(out: Path, run: Run) -> dict[str, Any]:
+    """The row recorded for a run, or {} when there is none (or it cannot be read)."""
     try:
-        return json.loads(path.read_text(encoding="utf-8")).get("error") is None
+        row = json.loads((out / "runs" / run.id / "row.json").read_text(encoding="utf-8"))
     except (OSError, json.JSONDecodeError):
-        return False
+        return {}
+    return row if isinstance(row, dict) else {}
+
+
+def _done(out: Path, run: Run, retry_failed: bool) -> bool:
+    row = _row(out, run)
+    return bool(row) and not (retry_failed and row.get("error") is not None)
 
 
 def _record(out: Path, row: dict[str, Any]) -> None:
@@ -300,7 +302,9 @@ def sweep(
     _open_folder(plan, out)
     todo = [r for r in plan.runs if not _done(out, r, retry_failed)]
     show = sys.stderr.isatty() if progress is None else progress
-    bar = _Progress(len(plan.runs), len(plan.runs) - len(todo), show)
+    skipped = [r for r in plan.runs if r not in todo]
+    failed = sum(_row(out, r).get("error") is not None for r in skipped)
+    bar = _Progress(len(plan.runs), len(plan.runs) - len(todo), failed, show)
     if limit is not None:
         todo = todo[:limit]
 
