@@ -344,13 +344,15 @@ def run_scenario(
     ``summary.json``, and the VTU series and GLB its ``[output]`` asks for), as
     ``myoslice run`` does, and returns the summary as a dict. With ``text``, the scenario is
     that TOML text and ``path`` only places its relative files and names it in errors.
-    With ``reuse_model``, the lattice of the last model built so in this process is
-    reused when the scenario's model (source, files, slicing) is the same: the same bits,
-    without the build's cost. The GIL is released while it runs."""
+    With ``reuse_model``, what was built for the last scenario run so in this process is
+    reused when the model (source, files, slicing) is the same: its lattice, and the whole
+    simulation when the settings are the same too (only schedules and muscle factors
+    differ). The same bits, without the build's cost. The GIL is released while it
+    runs."""
 
 def check_scenario(path: _StrPath, *, text: str | None = None, build: bool = False) -> None:
     """Reads and checks a scenario (every field, range and file, and the simulation's
     settings) without building it: raises what :func:`run_scenario` would raise before its
-    build. With ``build``, also builds its model (reusing the lattice as ``reuse_model``
-    does) so that the muscle and group names of ``[excitation]`` and ``[muscle.NAME]``
-    are checked too."""
+    build. With ``build``, also builds its model (reusing what was built as
+    ``reuse_model`` does) so that the muscle and group names of ``[excitation]`` and
+    ``[muscle.NAME]`` are checked too."""

@@ -19,38 +19,69 @@ fn scenario(py: Python<'_>, path: PathBuf, text: Option<String>) -> PyResult<Sce
     }
 }
 
-/// The lattice of the last model built with `reuse_model`, by its scenario's lattice key.
-static LAST_LATTICE: Mutex<Option<(String, Lattice)>> = Mutex::new(None);
+/// The last model built with `reuse_model`: its lattice, and the simulation built on it
+/// for one configuration, before any schedule or muscle factor.
+struct Kept {
+    lattice_key: String,
+    lattice: Lattice,
+    built: Option<(String, Simulation)>,
+}
 
-/// Builds the scenario's simulation on the kept lattice when the model is the same (the
-/// lattice build is most of a short run's time; a kept lattice gives the same bits).
+static KEPT: Mutex<Option<Kept>> = Mutex::new(None);
+
+fn kept() -> std::sync::MutexGuard<'static, Option<Kept>> {
+    KEPT.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Builds the scenario's simulation from what was kept of the last one when the model
+/// is the same: a clone of the simulation when the configuration is the same too (only
+/// schedules and muscle factors differ: the common case of sweeps and fits), else a new
+/// simulation on the kept lattice. Both give the same bits as a build from scratch; the
+/// lock is not held while building.
 fn build_reusing(sc: &Scenario) -> myoslice::Result<Simulation> {
     sc.check()?;
-    let key = sc.lattice_key();
-    let kept = {
-        let slot = LAST_LATTICE.lock().unwrap_or_else(|e| e.into_inner());
-        slot.as_ref()
-            .filter(|(k, _)| *k == key)
-            .map(|(_, l)| l.clone())
-    };
-    let lattice = match kept {
-        Some(l) => l,
+    let lattice_key = sc.lattice_key();
+    let config_key = format!("{:?}", sc.config());
+    let found = kept()
+        .as_ref()
+        .filter(|k| k.lattice_key == lattice_key)
+        .map(|k| match &k.built {
+            Some((c, sim)) if *c == config_key => Ok(sim.clone()),
+            _ => Err(k.lattice.clone()),
+        });
+    let mut sim = match found {
+        Some(Ok(sim)) => sim,
+        Some(Err(lattice)) => {
+            let sim = sc.simulation_on(lattice)?;
+            if let Some(k) = kept().as_mut().filter(|k| k.lattice_key == lattice_key) {
+                k.built = Some((config_key, sim.clone()));
+            }
+            sim
+        }
         None => {
-            let l = sc.lattice()?;
-            *LAST_LATTICE.lock().unwrap_or_else(|e| e.into_inner()) = Some((key, l.clone()));
-            l
+            let lattice = sc.lattice()?;
+            let sim = sc.simulation_on(lattice.clone())?;
+            *kept() = Some(Kept {
+                lattice_key,
+                lattice,
+                built: Some((config_key, sim.clone())),
+            });
+            sim
         }
     };
-    sc.build_on(lattice)
+    sc.apply_schedules(&mut sim)?;
+    Ok(sim)
 }
 
 /// Runs a scenario to its end into the folder `out` (`timeseries.csv`, `summary.json`,
 /// and the VTU series and GLB its `[output]` asks for), as `myoslice run` does, and
 /// returns the summary as a dict. With `text`, the scenario is that TOML text and `path`
-/// only places its relative files and names it in errors. With `reuse_model`, the
-/// lattice of the last model built so in this process is reused when the scenario's
-/// model (source, files, slicing) is the same: the same bits, without the build's cost
-/// (sweeps and fits run many scenarios of one model). The GIL is released while it runs.
+/// only places its relative files and names it in errors. With `reuse_model`, what was
+/// built for the last scenario run so in this process is reused when the model (source,
+/// files, slicing) is the same: its lattice, and the whole simulation when the settings
+/// are the same too (only schedules and muscle factors differ). The same bits, without
+/// the build's cost (sweeps and fits run many scenarios of one model). The GIL is
+/// released while it runs.
 #[pyfunction]
 #[pyo3(signature = (path, out, *, text = None, reuse_model = false))]
 pub(crate) fn run_scenario<'py>(
@@ -77,7 +108,7 @@ pub(crate) fn run_scenario<'py>(
 
 /// Reads and checks a scenario (every field, range and file, and the simulation's
 /// settings) without building it: raises what `run_scenario` would raise before its
-/// build. With `build`, also builds its model (reusing the lattice as `reuse_model` does)
+/// build. With `build`, also builds its model (reusing what was built as `reuse_model` does)
 /// so that the muscle and group names of `[excitation]` and `[muscle.NAME]` are checked
 /// too. `text` as in `run_scenario`.
 #[pyfunction]

@@ -490,10 +490,17 @@ impl Scenario {
     /// from an earlier build with the same [`Self::lattice_key`]), with its schedules and
     /// muscle factors applied.
     pub fn build_on(&self, lattice: crate::lattice::Lattice) -> Result<Simulation> {
-        let config = self.checked_config()?;
-        let mut sim = Simulation::new(lattice, config, &crate::muscle::MuscleCatalogue::default())?;
+        let mut sim = self.simulation_on(lattice)?;
         self.apply_schedules(&mut sim)?;
         Ok(sim)
+    }
+
+    /// The simulation its settings make on `lattice`, before [`Self::apply_schedules`]:
+    /// it depends only on the lattice and [`Self::config`], so one built for a scenario
+    /// serves (cloned) every scenario with the same lattice key and configuration.
+    pub fn simulation_on(&self, lattice: crate::lattice::Lattice) -> Result<Simulation> {
+        let config = self.checked_config()?;
+        Simulation::new(lattice, config, &crate::muscle::MuscleCatalogue::default())
     }
 
     /// Applies the excitation schedules and the muscles' parameter factors to a
