@@ -29,6 +29,12 @@ struct Kept {
 
 static KEPT: Mutex<Option<Kept>> = Mutex::new(None);
 
+/// What a new run can take from [`KEPT`].
+enum Found {
+    Simulation(Box<Simulation>),
+    Lattice(Box<Lattice>),
+}
+
 fn kept() -> std::sync::MutexGuard<'static, Option<Kept>> {
     KEPT.lock().unwrap_or_else(|e| e.into_inner())
 }
@@ -46,13 +52,13 @@ fn build_reusing(sc: &Scenario) -> myoslice::Result<Simulation> {
         .as_ref()
         .filter(|k| k.lattice_key == lattice_key)
         .map(|k| match &k.built {
-            Some((c, sim)) if *c == config_key => Ok(sim.clone()),
-            _ => Err(k.lattice.clone()),
+            Some((c, sim)) if *c == config_key => Found::Simulation(Box::new(sim.clone())),
+            _ => Found::Lattice(Box::new(k.lattice.clone())),
         });
     let mut sim = match found {
-        Some(Ok(sim)) => sim,
-        Some(Err(lattice)) => {
-            let sim = sc.simulation_on(lattice)?;
+        Some(Found::Simulation(sim)) => *sim,
+        Some(Found::Lattice(lattice)) => {
+            let sim = sc.simulation_on(*lattice)?;
             if let Some(k) = kept().as_mut().filter(|k| k.lattice_key == lattice_key) {
                 k.built = Some((config_key, sim.clone()));
             }
