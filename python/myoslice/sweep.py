@@ -301,12 +301,14 @@ def sweep(
     out = Path(out)
     _open_folder(plan, out)
     todo = [r for r in plan.runs if not _done(out, r, retry_failed)]
-    show = sys.stderr.isatty() if progress is None else progress
-    skipped = [r for r in plan.runs if r not in todo]
+    todo_ids = {r.id for r in todo}
+    skipped = [r for r in plan.runs if r.id not in todo_ids]
     failed = sum(_row(out, r).get("error") is not None for r in skipped)
-    bar = _Progress(len(plan.runs), len(plan.runs) - len(todo), failed, show)
     if limit is not None:
         todo = todo[:limit]
+    show = sys.stderr.isatty() if progress is None else progress
+    # The bar counts the runs recorded and those this call will run (limit included).
+    bar = _Progress(len(skipped) + len(todo), len(skipped), failed, show)
 
     def done(row: dict[str, Any]) -> None:
         _record(out, row)

@@ -19,24 +19,36 @@ fn scenario(py: Python<'_>, path: PathBuf, text: Option<String>) -> PyResult<Sce
     }
 }
 
-/// The last model built with `reuse_model`: its lattice, and the simulation built on it
-/// for one configuration, before any schedule or muscle factor.
+/// The last model built with `reuse_model`: its lattice, or the simulation built on it
+/// for one configuration, before any schedule or muscle factor (which holds the lattice).
 struct Kept {
     lattice_key: String,
-    lattice: Lattice,
-    built: Option<(String, Simulation)>,
+    model: Model,
+}
+
+enum Model {
+    Lattice(Box<Lattice>),
+    Built {
+        config_key: String,
+        sim: Box<Simulation>,
+    },
 }
 
 static KEPT: Mutex<Option<Kept>> = Mutex::new(None);
 
-/// What a new run can take from [`KEPT`].
-enum Found {
-    Simulation(Box<Simulation>),
-    Lattice(Box<Lattice>),
-}
-
 fn kept() -> std::sync::MutexGuard<'static, Option<Kept>> {
     KEPT.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Keeps `sim` (built for `config_key`) as the model of `lattice_key`, if that model is
+/// still the one kept.
+fn keep_built(lattice_key: &str, config_key: String, sim: &Simulation) {
+    if let Some(k) = kept().as_mut().filter(|k| k.lattice_key == lattice_key) {
+        k.model = Model::Built {
+            config_key,
+            sim: Box::new(sim.clone()),
+        };
+    }
 }
 
 /// Builds the scenario's simulation from what was kept of the last one when the model
@@ -51,27 +63,28 @@ fn build_reusing(sc: &Scenario) -> myoslice::Result<Simulation> {
     let found = kept()
         .as_ref()
         .filter(|k| k.lattice_key == lattice_key)
-        .map(|k| match &k.built {
-            Some((c, sim)) if *c == config_key => Found::Simulation(Box::new(sim.clone())),
-            _ => Found::Lattice(Box::new(k.lattice.clone())),
+        .map(|k| match &k.model {
+            Model::Built { config_key: c, sim } if *c == config_key => Ok(sim.clone()),
+            Model::Built { sim, .. } => Err(Box::new(sim.lattice().clone())),
+            Model::Lattice(l) => Err(l.clone()),
         });
     let mut sim = match found {
-        Some(Found::Simulation(sim)) => *sim,
-        Some(Found::Lattice(lattice)) => {
+        Some(Ok(sim)) => *sim,
+        Some(Err(lattice)) => {
             let sim = sc.simulation_on(*lattice)?;
-            if let Some(k) = kept().as_mut().filter(|k| k.lattice_key == lattice_key) {
-                k.built = Some((config_key, sim.clone()));
-            }
+            keep_built(&lattice_key, config_key, &sim);
             sim
         }
         None => {
             let lattice = sc.lattice()?;
-            let sim = sc.simulation_on(lattice.clone())?;
+            // Kept before the simulation's build, which may fail for this configuration
+            // and not for the next.
             *kept() = Some(Kept {
-                lattice_key,
-                lattice,
-                built: Some((config_key, sim.clone())),
+                lattice_key: lattice_key.clone(),
+                model: Model::Lattice(Box::new(lattice.clone())),
             });
+            let sim = sc.simulation_on(lattice)?;
+            keep_built(&lattice_key, config_key, &sim);
             sim
         }
     };
