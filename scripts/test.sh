@@ -3,8 +3,8 @@
 # off-screen viewer capture, Xvfb for the window's smoke test), Rust format/lint/tests,
 # then the Python package built as a wheel into a fresh virtual environment and its
 # pytest suite (bindings, Gymnasium env, stubs, scenario runs and their ParaView/Blender
-# outputs, sweeps on a local two-node Ray cluster, fits with Ray Tune), and RLlib's PPO
-# on the env in an environment of its own.
+# outputs, sweeps on a local two-node Ray cluster, fits with Ray Tune), the viewer's web
+# page in headless Chromium, and RLlib's PPO on the env in an environment of its own.
 # Usage: scripts/test.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,8 +20,10 @@ dpkg -s libvulkan1 >/dev/null 2>&1 || need_pkgs+=(libvulkan1)
 # A virtual X display for the interactive window's smoke test.
 dpkg -s xvfb >/dev/null 2>&1 || need_pkgs+=(xvfb)
 dpkg -s xauth >/dev/null 2>&1 || need_pkgs+=(xauth)
+# A real browser for the web page's tests (WebGL2 and WebGPU on SwiftShader).
+dpkg -s chromium >/dev/null 2>&1 || need_pkgs+=(chromium)
 if [ ${#need_pkgs[@]} -gt 0 ]; then
-  step "installing ${need_pkgs[*]} (software Vulkan, virtual display)"
+  step "installing ${need_pkgs[*]} (software Vulkan, virtual display, browser)"
   sudo_cmd=""
   [ "$(id -u)" = 0 ] || sudo_cmd="sudo"
   $sudo_cmd apt-get update -qq
@@ -38,6 +40,9 @@ step "cargo test (core, CLI, viewer incl. off-screen capture and the window on X
 cargo test --workspace --exclude myoslice-py
 step "release CLI (reference for the Python parity tests, scenario runs)"
 cargo build --release -p myoslice-cli
+step "the web page (scripts/web.sh: the viewer for wasm32, wasm-bindgen) and its lints"
+scripts/web.sh target/web
+cargo clippy --target wasm32-unknown-unknown -p myoslice-viewer --lib -- -D warnings
 
 # --- Python ----------------------------------------------------------------------------
 step "fresh virtual environment with the test requirements"
@@ -58,6 +63,9 @@ fi
 step "pytest"
 # From the repository root, so that the installed wheel (not python/myoslice/) is imported.
 .venv-test/bin/python -m pytest -q python/tests
+
+step "the web page in headless Chromium (WebGL2 and WebGPU, against the native run)"
+.venv-test/bin/python -m pytest -q tests/web
 
 step "RLlib (its own environment: RLlib pins an older gymnasium)"
 rm -rf .venv-rllib

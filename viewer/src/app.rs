@@ -2,13 +2,15 @@
 
 use std::path::PathBuf;
 use std::sync::Arc;
-use std::time::Instant;
+use web_time::Instant;
 
 use anyhow::{Result, anyhow};
 use myoslice::prelude::*;
 use winit::application::ApplicationHandler;
-use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
-use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, TouchPhase, WindowEvent};
+use winit::event_loop::ActiveEventLoop;
+#[cfg(not(target_arch = "wasm32"))]
+use winit::event_loop::{ControlFlow, EventLoop};
 use winit::window::{Window, WindowId};
 
 use crate::camera::{CameraPreset, OrbitCamera};
@@ -17,6 +19,7 @@ use crate::model::ModelSource;
 use crate::pick::{Ray, pick_muscle};
 use crate::render::{DEPTH, RenderSettings, Renderer};
 use crate::scene::{SceneMesh, SceneOptions};
+use crate::touch::{Gesture, Touches};
 use crate::ui::{UiAction, UiState};
 
 /// How far (px) the pointer may move between press and release and still be a click.
@@ -70,6 +73,7 @@ impl FrameStats {
 
 /// Opens the window on a model (or a scenario) and runs until it is closed (or for
 /// `opts.exit_after_frames`); returns the frame timing.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn run(source: ModelSource, scenario: Option<PathBuf>, opts: RunOptions) -> Result<FrameStats> {
     let event_loop = EventLoop::new().map_err(|e| {
         anyhow!("cannot open a window ({e}); without a display, use `viewer --capture out.png`")
@@ -90,22 +94,8 @@ pub fn run(source: ModelSource, scenario: Option<PathBuf>, opts: RunOptions) -> 
             load(&ModelSource::Phantom, None)?
         }
     };
-    ui.default_plot(&sim);
-    let mut app = App {
-        instance,
-        gfx: None,
-        sim,
-        ui,
-        scenario,
-        camera: None,
-        drag: None,
-        cursor: None,
-        press: None,
-        last: Instant::now(),
-        fatal: None,
-        opts,
-        stats: FrameStats::default(),
-    };
+    let mut app = App::new(sim, ui, scenario, opts);
+    app.instance = Some(instance);
     event_loop
         .run_app(&mut app)
         .map_err(|e| anyhow!("event loop: {e}"))?;
@@ -137,8 +127,14 @@ struct Gfx {
 }
 
 struct App {
-    instance: wgpu::Instance,
+    /// The instance the window's surface comes from (a page makes its own once the
+    /// browser says whether it has WebGPU).
+    #[cfg(not(target_arch = "wasm32"))]
+    instance: Option<wgpu::Instance>,
     gfx: Option<Gfx>,
+    /// A page's graphics, arriving from the browser's promises.
+    #[cfg(target_arch = "wasm32")]
+    arriving: web::Arriving,
     sim: Simulation,
     ui: UiState,
     scenario: Option<PathBuf>,
@@ -148,10 +144,21 @@ struct App {
     cursor: Option<(f64, f64)>,
     /// Where the left button went down, and the muscle under it then.
     press: Option<((f64, f64), Option<usize>)>,
+    /// Fingers on the view.
+    touches: Touches,
     last: Instant,
     fatal: Option<anyhow::Error>,
     opts: RunOptions,
     stats: FrameStats,
+}
+
+/// The format the frame is drawn in: the surface's, or its sRGB view's.
+fn view_format(config: &wgpu::SurfaceConfiguration) -> wgpu::TextureFormat {
+    config
+        .view_formats
+        .first()
+        .copied()
+        .unwrap_or(config.format)
 }
 
 fn targets(
@@ -179,7 +186,7 @@ fn targets(
     };
     let msaa = (samples > 1).then(|| {
         tex(
-            config.format,
+            view_format(config),
             wgpu::TextureUsages::RENDER_ATTACHMENT,
             "msaa",
         )
@@ -191,28 +198,71 @@ fn targets(
 }
 
 impl App {
+    fn new(sim: Simulation, ui: UiState, scenario: Option<PathBuf>, opts: RunOptions) -> Self {
+        let mut app = Self {
+            #[cfg(not(target_arch = "wasm32"))]
+            instance: None,
+            gfx: None,
+            #[cfg(target_arch = "wasm32")]
+            arriving: web::Arriving::default(),
+            sim,
+            ui,
+            scenario,
+            camera: None,
+            drag: None,
+            cursor: None,
+            press: None,
+            touches: Touches::default(),
+            last: Instant::now(),
+            fatal: None,
+            opts,
+            stats: FrameStats::default(),
+        };
+        app.ui.default_plot(&app.sim);
+        app
+    }
+
+    #[cfg(not(target_arch = "wasm32"))]
     fn init(&mut self, el: &ActiveEventLoop) -> Result<()> {
         let attrs = Window::default_attributes()
             .with_title("myoslice")
             .with_inner_size(winit::dpi::LogicalSize::new(1400.0, 860.0));
         let window = Arc::new(el.create_window(attrs)?);
-        let surface = self.instance.create_surface(window.clone())?;
-        let gpu = Gpu::with_instance(self.instance.clone(), Some(&surface))?;
+        let instance = self
+            .instance
+            .clone()
+            .ok_or_else(|| anyhow!("no graphics instance"))?;
+        let surface = instance.create_surface(window.clone())?;
+        let gpu = Gpu::with_instance(instance, Some(&surface))?;
+        self.attach(window, surface, gpu)
+    }
+
+    /// Sets up drawing into `window` once its surface and device exist.
+    fn attach(
+        &mut self,
+        window: Arc<Window>,
+        surface: wgpu::Surface<'static>,
+        gpu: Gpu,
+    ) -> Result<()> {
         let size = window.inner_size();
         let caps = surface.get_capabilities(&gpu.adapter);
         let mut config = surface
             .get_default_config(&gpu.adapter, size.width.max(1), size.height.max(1))
             .ok_or_else(|| anyhow!("the window surface is not supported by {}", gpu.describe()))?;
-        config.format = caps
-            .formats
-            .iter()
-            .copied()
-            .find(|f| f.is_srgb())
-            .unwrap_or(config.format);
+        // The renderer writes linear colour for an sRGB target to encode. A browser's
+        // WebGPU canvas has no sRGB format: it is drawn through an sRGB view of it.
+        match caps.formats.iter().copied().find(|f| f.is_srgb()) {
+            Some(f) => config.format = f,
+            None if config.format.add_srgb_suffix() != config.format => {
+                config.view_formats = vec![config.format.add_srgb_suffix()];
+            }
+            None => {}
+        }
         config.present_mode = wgpu::PresentMode::AutoVsync;
         surface.configure(&gpu.device, &config);
-        let samples = gpu.msaa_samples(config.format);
-        let renderer = Renderer::new(&gpu, config.format, samples);
+        let format = view_format(&config);
+        let samples = gpu.msaa_samples(format);
+        let renderer = Renderer::new(&gpu, format, samples);
         let (msaa, depth) = targets(&gpu, &config, samples);
         let egui_ctx = egui::Context::default();
         let egui_state = egui_winit::State::new(
@@ -223,11 +273,8 @@ impl App {
             None,
             Some(gpu.device.limits().max_texture_dimension_2d as usize),
         );
-        let egui_renderer = egui_wgpu::Renderer::new(
-            &gpu.device,
-            config.format,
-            egui_wgpu::RendererOptions::default(),
-        );
+        let egui_renderer =
+            egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
         self.gfx = Some(Gfx {
             window,
             surface,
@@ -281,24 +328,39 @@ impl App {
                     self.camera = Some(self.frame_camera(p));
                     Ok(())
                 }
-                UiAction::Load(src) => match load(&src, None) {
-                    Ok(s) => {
-                        self.sim = with_models_of(s, &self.sim);
-                        self.ui.selected = None;
-                        self.ui.hovered = None;
-                        self.ui.source = src;
-                        self.scenario = None;
-                        self.ui.default_plot(&self.sim);
-                        self.camera = None;
-                        Ok(())
-                    }
-                    Err(e) => Err(e),
-                },
+                UiAction::Load(src) => load(&src, None).map(|s| self.switch_to(src, s)),
             };
             if let Err(e) = r {
                 self.ui.error = Some(format!("{e:#}"));
             }
         }
+    }
+
+    /// A finger's event on the view (`panel`: the panel has it).
+    fn touch(&mut self, id: u64, phase: TouchPhase, at: (f64, f64), panel: bool, height: f32) {
+        let gesture = self.touches.event(id, phase, at, panel);
+        let (Some(cam), Some(g)) = (self.camera.as_mut(), gesture) else {
+            return;
+        };
+        match g {
+            Gesture::Orbit(dx, dy) => cam.orbit(dx, dy, 0.006),
+            Gesture::PinchPan { zoom, pan } => {
+                cam.zoom(zoom);
+                cam.pan(pan.0, pan.1, height);
+            }
+        }
+    }
+
+    /// Runs `sim`, built from `src`, instead of the model before (keeping the models
+    /// chosen in the panel).
+    fn switch_to(&mut self, src: ModelSource, sim: Simulation) {
+        self.sim = with_models_of(sim, &self.sim);
+        self.ui.selected = None;
+        self.ui.hovered = None;
+        self.ui.source = src;
+        self.scenario = None;
+        self.ui.default_plot(&self.sim);
+        self.camera = None;
     }
 
     fn frame_camera(&self, preset: CameraPreset) -> OrbitCamera {
@@ -356,9 +418,10 @@ impl App {
                 return;
             }
         };
-        let view = frame
-            .texture
-            .create_view(&wgpu::TextureViewDescriptor::default());
+        let view = frame.texture.create_view(&wgpu::TextureViewDescriptor {
+            format: Some(view_format(&g.config)),
+            ..Default::default()
+        });
         let scene = SceneMesh::build(&self.sim, &self.ui.scene_options());
         self.ui.color_range = scene.color_range;
         let aspect = g.config.width as f32 / g.config.height.max(1) as f32;
@@ -512,6 +575,11 @@ impl ApplicationHandler for App {
                     *last = (position.x, position.y);
                 }
             }
+            WindowEvent::Touch(t) => {
+                let at = (t.location.x, t.location.y);
+                let height = g.config.height as f32;
+                self.touch(t.id, t.phase, at, resp.consumed || egui_wants, height);
+            }
             WindowEvent::MouseWheel { delta, .. } if !egui_wants => {
                 let lines = match delta {
                     MouseScrollDelta::LineDelta(_, y) => y,
@@ -526,6 +594,8 @@ impl ApplicationHandler for App {
     }
 
     fn about_to_wait(&mut self, el: &ActiveEventLoop) {
+        #[cfg(target_arch = "wasm32")]
+        self.page_tick();
         if self
             .opts
             .exit_after_frames
@@ -539,6 +609,10 @@ impl ApplicationHandler for App {
         }
     }
 }
+
+#[cfg(target_arch = "wasm32")]
+#[path = "web.rs"]
+pub mod web;
 
 /// `new` with the muscle and tendon models `old` runs now: the panel's choice outlives a
 /// reset or a load (the source's own models are only where a session starts), a muscle's

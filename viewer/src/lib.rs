@@ -15,6 +15,8 @@ pub mod scene;
 #[cfg(feature = "window")]
 pub mod app;
 #[cfg(feature = "window")]
+pub mod touch;
+#[cfg(feature = "window")]
 pub mod ui;
 
 pub use camera::{CameraPreset, OrbitCamera};

@@ -1,7 +1,8 @@
 //! Which model to load: the phantom, a label volume (NIfTI, NRRD, Slicer segmentation)
 //! with what its labels mean, or a scenario.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use anyhow::{Context, Result, bail};
 use myoslice::prelude::*;
@@ -23,6 +24,26 @@ pub enum ModelSource {
         names: Option<PathBuf>,
         /// What becomes of label names no structure is known by.
         unmapped: Unmapped,
+    },
+    /// Files already read (a web page's picked or dropped files): a label volume and,
+    /// unless it names its own labels, its label table or label list.
+    Files {
+        /// The volume's file name (for messages, and its format's ending).
+        volume_name: String,
+        /// The volume's bytes.
+        volume: Arc<[u8]>,
+        /// The label file's name and text.
+        labels: Option<(String, Arc<str>)>,
+        /// What becomes of label names no structure is known by.
+        unmapped: Unmapped,
+    },
+    /// A scenario's text and file name (its model files, if any, are read from where
+    /// it names them).
+    ScenarioText {
+        /// The file name.
+        name: String,
+        /// The TOML text.
+        text: Arc<str>,
     },
 }
 
@@ -60,6 +81,30 @@ impl ModelSource {
                 )
                 .with_context(|| format!("building the model from {}", volume.display()))
             }
+            ModelSource::Files {
+                volume_name,
+                volume,
+                labels,
+                unmapped,
+            } => {
+                let labels = labels.as_ref().map(|(n, t)| (&**t, n.as_str()));
+                let (v, t) =
+                    myoslice::io::parse_segmentation(volume, volume_name, labels, *unmapped)
+                        .with_context(|| format!("reading {volume_name}"))?;
+                let lattice = Lattice::build(&v, &t, &BuildOptions::default())
+                    .with_context(|| format!("building the model from {volume_name}"))?;
+                Simulation::new(
+                    lattice,
+                    config,
+                    &myoslice::muscle::MuscleCatalogue::default(),
+                )
+                .with_context(|| format!("building the model from {volume_name}"))
+            }
+            ModelSource::ScenarioText { name, text } => {
+                Scenario::from_str_at(text, Path::new(name))
+                    .and_then(|sc| sc.build())
+                    .with_context(|| format!("building the scenario {name}"))
+            }
         }
     }
 
@@ -68,6 +113,8 @@ impl ModelSource {
         match self {
             ModelSource::Phantom => "built-in phantom".into(),
             ModelSource::Volume { volume, .. } => volume.display().to_string(),
+            ModelSource::Files { volume_name, .. } => volume_name.clone(),
+            ModelSource::ScenarioText { name, .. } => name.clone(),
         }
     }
 }

@@ -521,6 +521,39 @@ impl UiState {
             });
     }
 
+    /// What becomes of label names no structure is known by, for the next load.
+    fn unknown_names(&mut self, ui: &mut egui::Ui) {
+        ui.horizontal(|ui| {
+            ui.label("unknown names");
+            for (rule, text) in [
+                (Unmapped::Error, "refuse"),
+                (Unmapped::Fat, "fat"),
+                (Unmapped::Ignore, "background"),
+            ] {
+                ui.radio_value(&mut self.open_unmapped, rule, text);
+            }
+        });
+    }
+
+    /// In a page, files come from the page's Open button or a drop (no paths to type).
+    #[cfg(target_arch = "wasm32")]
+    fn open_form(&mut self, ui: &mut egui::Ui, actions: &mut Vec<UiAction>) {
+        egui::CollapsingHeader::new("Open model")
+            .default_open(false)
+            .show(ui, |ui| {
+                ui.label(
+                    "Drop a label volume (NIfTI, NRRD, a Slicer .seg.nrrd) with its label \
+                     table or label list on the page, or a scenario (.toml); or use the \
+                     page's Open button.",
+                );
+                self.unknown_names(ui);
+                if ui.button("Phantom").clicked() {
+                    actions.push(UiAction::Load(ModelSource::Phantom));
+                }
+            });
+    }
+
+    #[cfg(not(target_arch = "wasm32"))]
     fn open_form(&mut self, ui: &mut egui::Ui, actions: &mut Vec<UiAction>) {
         egui::CollapsingHeader::new("Open model")
             .default_open(false)
@@ -537,16 +570,7 @@ impl UiState {
                     ui.label("names");
                     ui.text_edit_singleline(&mut self.open_names);
                 });
-                ui.horizontal(|ui| {
-                    ui.label("unknown names");
-                    for (rule, text) in [
-                        (Unmapped::Error, "refuse"),
-                        (Unmapped::Fat, "fat"),
-                        (Unmapped::Ignore, "background"),
-                    ] {
-                        ui.radio_value(&mut self.open_unmapped, rule, text);
-                    }
-                });
+                self.unknown_names(ui);
                 ui.horizontal(|ui| {
                     if ui.button("Load volume").clicked() {
                         let path = |s: &str| (!s.trim().is_empty()).then(|| s.trim().into());

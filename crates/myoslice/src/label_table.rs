@@ -179,21 +179,31 @@ impl LabelTable {
         path: impl AsRef<Path>,
         mapping: impl Into<LabelMapping>,
     ) -> Result<(Self, Option<Vec<MappedLabel>>)> {
-        let mapping = mapping.into();
         let path = path.as_ref();
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-        let origin = path.display().to_string();
-        let toml_ext = path
+        Self::parse_mapped(&text, &path.display().to_string(), mapping)
+    }
+
+    /// [`Self::read_mapped`] of a file's text already read (a page's dropped file);
+    /// `origin` is its name, whose `.toml` ending counts as for a path.
+    pub fn parse_mapped(
+        text: &str,
+        origin: &str,
+        mapping: impl Into<LabelMapping>,
+    ) -> Result<(Self, Option<Vec<MappedLabel>>)> {
+        let mapping = mapping.into();
+        let origin = origin.to_string();
+        let toml_ext = Path::new(&origin)
             .extension()
             .and_then(|e| e.to_str())
             .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
         if text.trim_start().starts_with('{') {
-            return Ok((Self::from_json_str(&text, &origin)?, None));
+            return Ok((Self::from_json_str(text, &origin)?, None));
         }
-        if toml_ext || sniff_label_list(&text).is_none() {
-            return Ok((Self::from_toml_str(&text, &origin)?, None));
+        if toml_ext || sniff_label_list(text).is_none() {
+            return Ok((Self::from_toml_str(text, &origin)?, None));
         }
-        let list = parse_label_list(&text, &origin)?;
+        let list = parse_label_list(text, &origin)?;
         let (table, how) = map_labels(&list, mapping.names()?, mapping.unmapped(), &origin)?;
         Ok((table, Some(how)))
     }

@@ -90,3 +90,39 @@ fn unknown_names_are_refused_by_default_and_taken_as_asked_otherwise() {
     assert_eq!(LabelTable::from_path(&json).unwrap(), fat);
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn files_already_read_give_the_same_volume_and_table_as_their_paths() {
+    // As a web page hands them over: bytes and names, no file system.
+    let (volume, table) = myoslice::phantom::Phantom::default().generate().unwrap();
+    let dir = scratch("bytes");
+    let nii = myoslice::io::encode_nifti(&volume);
+    std::fs::write(dir.join("leg.nii"), &nii).unwrap();
+    let texts: [(&str, String); 2] = [
+        ("leg.json", table.to_json()),
+        ("leg-labels.txt", itk_snap(&table)),
+    ];
+    for (file, text) in texts {
+        std::fs::write(dir.join(file), &text).unwrap();
+        let (v0, t0) = myoslice::io::read_segmentation(
+            dir.join("leg.nii"),
+            Some(&dir.join(file)),
+            Unmapped::Error,
+        )
+        .unwrap();
+        let (v1, t1) =
+            myoslice::io::parse_segmentation(&nii, "leg.nii", Some((&text, file)), Unmapped::Error)
+                .unwrap();
+        assert!(v0.data() == v1.data() && v0.dims() == v1.dims(), "{file}");
+        assert_eq!(t0.to_json(), t1.to_json(), "{file}");
+    }
+    // A corrupt volume names the file it was given as.
+    let err = myoslice::io::parse_segmentation(
+        &nii[..100],
+        "broken.nii",
+        Some((&table.to_json(), "leg.json")),
+        Unmapped::Error,
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("broken.nii"), "{err}");
+}

@@ -2,7 +2,7 @@
 //! `run_scenario` and the sweeps all do, so that they give the same bits.
 
 use std::path::Path;
-use std::time::Instant;
+use web_time::Instant;
 
 use super::run::{RunOutputs, RunSummary, RunWriter};
 use crate::error::Result;

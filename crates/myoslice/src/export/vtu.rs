@@ -166,10 +166,12 @@ pub fn write_pvd(path: &Path, frames: &[(f64, String)]) -> Result<()> {
 /// Writes bytes to a temporary file beside `path`, then renames it into place.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let tmp = path.with_extension("partial");
-    let mut f = std::fs::File::create(&tmp).map_err(|e| Error::write(&tmp, e))?;
-    f.write_all(bytes).map_err(|e| Error::write(&tmp, e))?;
-    f.sync_all().map_err(|e| Error::write(&tmp, e))?;
-    drop(f);
+    {
+        // Closed before the rename.
+        let mut f = std::fs::File::create(&tmp).map_err(|e| Error::write(&tmp, e))?;
+        f.write_all(bytes).map_err(|e| Error::write(&tmp, e))?;
+        f.sync_all().map_err(|e| Error::write(&tmp, e))?;
+    }
     std::fs::rename(&tmp, path).map_err(|e| Error::write(path, e))
 }
 

@@ -24,11 +24,20 @@ pub fn read_label_volume(
 ) -> crate::Result<(crate::LabelVolume, Option<LabelNames>)> {
     let path = path.as_ref();
     let raw = std::fs::read(path).map_err(|e| crate::Error::io(path, e))?;
-    if is_nrrd(&raw) {
-        let v = parse_nrrd(&raw, path)?;
+    parse_label_volume(&raw, path)
+}
+
+/// [`read_label_volume`] of a file's bytes already read (a page's dropped file; an NRRD
+/// must carry its data: a detached one's data file is looked for beside `path`).
+pub fn parse_label_volume(
+    raw: &[u8],
+    path: &std::path::Path,
+) -> crate::Result<(crate::LabelVolume, Option<LabelNames>)> {
+    if is_nrrd(raw) {
+        let v = parse_nrrd(raw, path)?;
         Ok((v.volume.in_frame()?, v.segments))
     } else {
-        Ok((parse_nifti(&raw, path)?.in_frame()?, None))
+        Ok((parse_nifti(raw, path)?.in_frame()?, None))
     }
 }
 
@@ -56,7 +65,40 @@ pub fn read_segmentation(
     let volume = volume.as_ref();
     let mapping = mapping.into();
     let (v, segments) = read_label_volume(volume)?;
-    let table = match (labels, segments) {
+    let labels = match labels {
+        Some(l) => {
+            let text = std::fs::read_to_string(l).map_err(|e| crate::Error::io(l, e))?;
+            Some((text, l.display().to_string()))
+        }
+        None => None,
+    };
+    let table = table_of(volume, segments, labels, mapping)?;
+    Ok((v, table))
+}
+
+/// [`read_segmentation`] of files already read (a web page's picked or dropped files): the
+/// volume's bytes with its name, and the label file's text with its name.
+pub fn parse_segmentation(
+    volume: &[u8],
+    volume_name: &str,
+    labels: Option<(&str, &str)>,
+    mapping: impl Into<crate::label_mapping::LabelMapping>,
+) -> crate::Result<(crate::LabelVolume, crate::LabelTable)> {
+    let path = std::path::Path::new(volume_name);
+    let (v, segments) = parse_label_volume(volume, path)?;
+    let labels = labels.map(|(text, name)| (text.to_string(), name.to_string()));
+    Ok((v, table_of(path, segments, labels, mapping.into())?))
+}
+
+/// The label table of a volume: from the label file's `(text, name)`, or else from the
+/// segment names the volume carries.
+fn table_of(
+    volume: &std::path::Path,
+    segments: Option<LabelNames>,
+    labels: Option<(String, String)>,
+    mapping: crate::label_mapping::LabelMapping,
+) -> crate::Result<crate::LabelTable> {
+    Ok(match (labels, segments) {
         (Some(_), Some(_)) => {
             return Err(crate::Error::parse(
                 volume,
@@ -64,7 +106,7 @@ pub fn read_segmentation(
                  the file's order), so no label file applies to it: leave the label file out",
             ));
         }
-        (Some(l), None) => crate::LabelTable::from_path_with(l, mapping)?,
+        (Some((text, name)), None) => crate::LabelTable::parse_mapped(&text, &name, mapping)?.0,
         (None, Some(list)) => {
             let origin = volume.display().to_string();
             crate::label_names::map_labels(&list, mapping.names()?, mapping.unmapped(), &origin)?.0
@@ -76,8 +118,7 @@ pub fn read_segmentation(
                  file or a Slicer colour table with it",
             ));
         }
-    };
-    Ok((v, table))
+    })
 }
 
 /// A label volume and its table from any input myoslice reads, told apart by content

@@ -2,7 +2,7 @@
 //! updated at its own rate, rolled back whole if anything fails.
 
 use std::panic::AssertUnwindSafe;
-use std::time::Instant;
+use web_time::Instant;
 
 use glam::Vec3;
 

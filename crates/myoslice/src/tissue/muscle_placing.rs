@@ -4,7 +4,7 @@
 //! `Simulation::step` places the next update's shapes beside the last update's guard
 //! (see [`super::Tissue::update_back_beside`]).
 
-use std::time::Instant;
+use web_time::Instant;
 
 use glam::Quat;
 use rayon::prelude::*;

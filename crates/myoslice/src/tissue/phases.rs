@@ -1,6 +1,6 @@
 //! Where a tissue update's wall-clock time goes, phase by phase.
 
-use std::time::Instant;
+use web_time::Instant;
 
 /// Wall-clock time (s) of tissue updates, phase by phase, in the order an update runs
 /// them (see [`crate::StepTimers::tissue_phases`]).

@@ -44,7 +44,7 @@ impl Tissue {
             };
             let (back, r) = rayon::join(
                 || {
-                    let start = std::time::Instant::now();
+                    let start = web_time::Instant::now();
                     (self.update_back(front), start.elapsed())
                 },
                 || beside(&mut placing),
