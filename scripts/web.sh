@@ -3,13 +3,17 @@
 # (default target/web). Serve the folder with any static server, e.g.
 #   python3 -m http.server -d target/web 8000   # then open http://127.0.0.1:8000
 # Installs what it needs on first use: the wasm32 target (rustup) and wasm-bindgen-cli at
-# the version of the wasm-bindgen crate in Cargo.lock (into target/tools).
+# the version of the wasm-bindgen crate in Cargo.lock (into the target folder's tools/).
 # MYOSLICE_WASM_OPT=1 also shrinks the wasm with binaryen's wasm-opt (a recent one).
 # Usage: scripts/web.sh [DIR]
 set -euo pipefail
+# DIR is taken from where the script is called.
+out=${1:-}
+case "$out" in "" | /*) ;; *) out="$PWD/$out" ;; esac
 cd "$(dirname "$0")/.."
 root=$(pwd)
-out=${1:-target/web}
+target=${CARGO_TARGET_DIR:-$root/target}
+out=${out:-$target/web}
 
 rustup target list --installed | grep -qx wasm32-unknown-unknown \
   || rustup target add wasm32-unknown-unknown
@@ -17,10 +21,11 @@ rustup target list --installed | grep -qx wasm32-unknown-unknown \
 # The CLI must be the exact version of the crate the wasm was built with.
 version=$(awk '/^name = "wasm-bindgen"$/ { getline; gsub(/"/, "", $3); print $3; exit }' Cargo.lock)
 [ -n "$version" ] || { echo "no wasm-bindgen in Cargo.lock" >&2; exit 1; }
-bindgen="$root/target/tools/bin/wasm-bindgen"
+bindgen="$target/tools/bin/wasm-bindgen"
 if ! "$bindgen" --version 2>/dev/null | grep -q " $version\$"; then
-  echo "installing wasm-bindgen-cli $version into target/tools"
-  cargo install --quiet wasm-bindgen-cli --version "$version" --root "$root/target/tools"
+  echo "installing wasm-bindgen-cli $version into $target/tools"
+  # Not --locked: its lock file names a release the registry no longer serves.
+  cargo install --quiet wasm-bindgen-cli --version "$version" --root "$target/tools"
 fi
 
 # The viewer's library as a cdylib (natively it stays an rlib); no debug info in the page.
@@ -29,7 +34,7 @@ CARGO_PROFILE_RELEASE_DEBUG=false cargo rustc --quiet --release \
 
 mkdir -p "$out"
 "$bindgen" --target web --no-typescript --out-dir "$out" --out-name myoslice_viewer \
-  target/wasm32-unknown-unknown/release/myoslice_viewer.wasm
+  "$target/wasm32-unknown-unknown/release/myoslice_viewer.wasm"
 # Opt-in: binaryen 108 (Debian 12's) rewrites the module's reference-typed table into one
 # the browser refuses (the page does not start), so wasm-opt runs only when asked.
 if [ "${MYOSLICE_WASM_OPT:-0}" = 1 ]; then
@@ -38,6 +43,6 @@ if [ "${MYOSLICE_WASM_OPT:-0}" = 1 ]; then
     "$out/myoslice_viewer_bg.wasm" -o "$out/myoslice_viewer_bg.wasm"
 fi
 cp viewer/web/index.html "$out/index.html"
-raw=$(stat -c %s "$out/myoslice_viewer_bg.wasm")
+raw=$(wc -c < "$out/myoslice_viewer_bg.wasm")
 gz=$(gzip -9c "$out/myoslice_viewer_bg.wasm" | wc -c)
 echo "web page in $out: wasm $((raw / 1024)) KiB ($((gz / 1024)) KiB gzipped)"

@@ -253,7 +253,16 @@ impl App {
         // WebGPU canvas has no sRGB format: it is drawn through an sRGB view of it.
         match caps.formats.iter().copied().find(|f| f.is_srgb()) {
             Some(f) => config.format = f,
-            None if config.format.add_srgb_suffix() != config.format => {
+            // Only where the device may view the surface in another format (not on GL,
+            // nor on Vulkan without mutable swapchain formats): elsewhere the colours
+            // come out darker, but the window opens.
+            None if config.format.add_srgb_suffix() != config.format
+                && gpu
+                    .adapter
+                    .get_downlevel_capabilities()
+                    .flags
+                    .contains(wgpu::DownlevelFlags::SURFACE_VIEW_FORMATS) =>
+            {
                 config.view_formats = vec![config.format.add_srgb_suffix()];
             }
             None => {}
@@ -351,10 +360,13 @@ impl App {
         }
     }
 
-    /// Runs `sim`, built from `src`, instead of the model before (keeping the models
-    /// chosen in the panel).
+    /// Runs `sim`, built from `src`, instead of the model before, with the muscle and
+    /// tendon models chosen in the panel (a scenario's own stay).
     fn switch_to(&mut self, src: ModelSource, sim: Simulation) {
-        self.sim = with_models_of(sim, &self.sim);
+        self.sim = match src {
+            ModelSource::ScenarioText { .. } => sim,
+            _ => with_models_of(sim, &self.sim),
+        };
         self.ui.selected = None;
         self.ui.hovered = None;
         self.ui.source = src;
@@ -562,9 +574,12 @@ impl ApplicationHandler for App {
             WindowEvent::CursorLeft { .. } => self.cursor = None,
             WindowEvent::CursorMoved { position, .. } => {
                 self.cursor = Some((position.x, position.y));
-                if let (Some((button, last)), Some(cam)) =
-                    (self.drag.as_mut(), self.camera.as_mut())
-                {
+                // A system that makes mouse moves of a finger's would turn the view twice.
+                if let (Some((button, last)), Some(cam), true) = (
+                    self.drag.as_mut(),
+                    self.camera.as_mut(),
+                    self.touches.is_empty(),
+                ) {
                     if last.0.is_finite() {
                         let (dx, dy) = ((position.x - last.0) as f32, (position.y - last.1) as f32);
                         match button {
@@ -578,7 +593,16 @@ impl ApplicationHandler for App {
             WindowEvent::Touch(t) => {
                 let at = (t.location.x, t.location.y);
                 let height = g.config.height as f32;
-                self.touch(t.id, t.phase, at, resp.consumed || egui_wants, height);
+                // Whose the finger is, by where it comes down (egui's own notion of the
+                // pointer is the last frame's, and gone once a finger lifts).
+                let ppp = f64::from(g.egui_ctx.pixels_per_point());
+                let point = egui::pos2((at.0 / ppp) as f32, (at.1 / ppp) as f32);
+                let panel = resp.consumed
+                    || self.ui.panel_rect.is_some_and(|r| r.contains(point))
+                    || g.egui_ctx
+                        .layer_id_at(point)
+                        .is_some_and(|l| l.order != egui::Order::Background);
+                self.touch(t.id, t.phase, at, panel, height);
             }
             WindowEvent::MouseWheel { delta, .. } if !egui_wants => {
                 let lines = match delta {

@@ -109,6 +109,8 @@ pub struct UiState {
     pub open_unmapped: Unmapped,
     /// The model shown.
     pub source: ModelSource,
+    /// Where the panel was drawn last (points): a finger put down there is the panel's.
+    pub panel_rect: Option<egui::Rect>,
 }
 
 impl Default for UiState {
@@ -132,6 +134,7 @@ impl Default for UiState {
             open_names: String::new(),
             open_unmapped: Unmapped::Error,
             source: ModelSource::Phantom,
+            panel_rect: None,
         }
     }
 }
@@ -209,7 +212,7 @@ impl UiState {
     /// Draws the panel; returns the actions to carry out.
     pub fn show(&mut self, ui: &mut egui::Ui, sim: &mut Simulation) -> Vec<UiAction> {
         let mut actions = Vec::new();
-        egui::Panel::left("controls")
+        let panel = egui::Panel::left("controls")
             .resizable(true)
             .default_size(330.0)
             .show(ui, |ui| {
@@ -229,6 +232,7 @@ impl UiState {
                     self.open_form(ui, &mut actions);
                 });
             });
+        self.panel_rect = Some(panel.response.rect);
         let ctx = ui.ctx().clone();
         if let (Some(text), Some(pos)) =
             (self.hover_text(sim), ctx.input(|i| i.pointer.hover_pos()))

@@ -15,7 +15,7 @@ use anyhow::{Result, anyhow};
 use myoslice::prelude::*;
 use wasm_bindgen::prelude::*;
 use web_time::Instant;
-use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
 use winit::platform::web::{EventLoopExtWebSys, WindowAttributesExtWebSys};
 use winit::window::Window;
 
@@ -34,13 +34,17 @@ const RUN_TO_CHUNK_S: f64 = 0.1;
 /// A window's surface and device, once the browser's promises resolve.
 type Ready = Result<(Arc<Window>, wgpu::Surface<'static>, Gpu)>;
 
-/// Where the graphics arrive (see [`App::page_tick`]).
-pub(super) type Arriving = Rc<RefCell<Option<Ready>>>;
+/// Where the graphics arrive (see [`App::page_tick`]), and how their arrival wakes the
+/// event loop.
+#[derive(Default)]
+pub(super) struct Arriving {
+    slot: Rc<RefCell<Option<Ready>>>,
+    wake: Option<EventLoopProxy<()>>,
+}
 
 /// What the page asked for, waiting for the next frame.
 enum Command {
     Preset(Preset),
-    RunTo(f64),
     Open(Vec<(String, Vec<u8>)>),
     Playing(bool),
 }
@@ -67,6 +71,10 @@ struct Page {
     /// Mean time (ms) of the frames after the first, and of the simulation in them.
     frame_ms: f64,
     sim_ms: f64,
+    /// Wall time (s) spent stepping toward [`run_to`] targets (frames apart).
+    run_wall_s: f64,
+    /// Where the 3D view starts on the canvas (pixels): the panel's right edge.
+    view_left_px: f32,
     /// The knee axis's centre on the canvas (pixels from its top-left corner) and pixels
     /// per metre at its depth.
     knee_px: Option<([f32; 2], f32)>,
@@ -99,7 +107,9 @@ pub fn start() {
 fn launch() -> Result<()> {
     let event_loop =
         EventLoop::new().map_err(|e| anyhow!("cannot start the page's event loop: {e}"))?;
-    event_loop.set_control_flow(ControlFlow::Poll);
+    // Frames come from the browser's animation frames (each asks for the next): between
+    // them the page's thread is free.
+    event_loop.set_control_flow(ControlFlow::Wait);
     let t0 = Instant::now();
     let sim = load(&ModelSource::Phantom, None)?;
     let build_ms = t0.elapsed().as_secs_f64() * 1e3;
@@ -116,7 +126,8 @@ fn launch() -> Result<()> {
         playing: !paused,
         ..UiState::default()
     };
-    let app = App::new(sim, ui, None, RunOptions::default());
+    let mut app = App::new(sim, ui, None, RunOptions::default());
+    app.arriving.wake = Some(event_loop.create_proxy());
     event_loop.spawn_app(app);
     Ok(())
 }
@@ -126,7 +137,9 @@ fn launch() -> Result<()> {
 /// error, or null), `frames`, `running` (a [`run_to`] under way), `knee_px` (the knee
 /// axis's centre on the canvas, in pixels), `px_per_m` (pixels per metre there),
 /// `first_frame_ms` (from the page's start to its first frame), `frame_ms` and `sim_ms`
-/// (mean time of a frame after the first, and of the simulation in it).
+/// (mean time of a frame after the first, and of the simulation in it), `view_left_px`
+/// (where the 3D view starts, right of the panel), `run_wall_s` (wall time spent stepping
+/// toward [`run_to`] targets, the frames apart).
 #[wasm_bindgen]
 pub fn status() -> String {
     page(|p| {
@@ -143,6 +156,8 @@ pub fn status() -> String {
             "first_frame_ms": p.first_frame_ms,
             "frame_ms": p.frame_ms,
             "sim_ms": p.sim_ms,
+            "view_left_px": p.view_left_px,
+            "run_wall_s": p.run_wall_s,
             "knee_px": p.knee_px.map(|k| k.0),
             "px_per_m": p.knee_px.map(|k| k.1),
         })
@@ -164,6 +179,7 @@ pub fn open_files() {
     page(|p| {
         let files = std::mem::take(&mut p.files);
         p.commands.push(Command::Open(files));
+        p.error = None;
     });
 }
 
@@ -188,7 +204,8 @@ pub fn run_to(seconds: f64) -> Result<(), JsValue> {
             "run_to({seconds}): expected a finite time >= 0"
         )));
     }
-    page(|p| p.commands.push(Command::RunTo(seconds)));
+    // Set at once, so that `status().running` says so from this call on.
+    page(|p| p.running_to = Some(seconds));
     Ok(())
 }
 
@@ -196,56 +213,6 @@ pub fn run_to(seconds: f64) -> Result<(), JsValue> {
 #[wasm_bindgen]
 pub fn set_playing(playing: bool) {
     page(|p| p.commands.push(Command::Playing(playing)));
-}
-
-/// What a set of files is: a scenario, or a volume with its label file.
-fn source_of(mut files: Vec<(String, Vec<u8>)>, unmapped: Unmapped) -> Result<ModelSource> {
-    if files.is_empty() {
-        return Err(anyhow!("no file given"));
-    }
-    // The volume: binary, or named like one; the rest is its label file.
-    let is_volume = |(name, bytes): &(String, Vec<u8>)| {
-        let n = name.to_ascii_lowercase();
-        n.ends_with(".nii")
-            || n.ends_with(".nii.gz")
-            || n.ends_with(".nrrd")
-            || std::str::from_utf8(&bytes[..bytes.len().min(4096)]).is_err()
-    };
-    let Some(at) = files.iter().position(is_volume) else {
-        if let [(name, bytes)] = files.as_slice() {
-            let text = String::from_utf8(bytes.clone())
-                .map_err(|_| anyhow!("{name} is neither a label volume nor a text scenario"))?;
-            return Ok(ModelSource::ScenarioText {
-                name: name.clone(),
-                text: text.into(),
-            });
-        }
-        return Err(anyhow!(
-            "none of the files is a label volume (NIfTI .nii/.nii.gz, NRRD .nrrd, a Slicer \
-             segmentation .seg.nrrd)"
-        ));
-    };
-    let (volume_name, volume) = files.remove(at);
-    let labels = match files.as_slice() {
-        [] => None,
-        [(name, bytes)] => {
-            let text = String::from_utf8(bytes.clone())
-                .map_err(|_| anyhow!("the label file {name} is not text"))?;
-            Some((name.clone(), text.into()))
-        }
-        _ => {
-            return Err(anyhow!(
-                "give one label volume and at most one label file (got {} files)",
-                files.len() + 1
-            ));
-        }
-    };
-    Ok(ModelSource::Files {
-        volume_name,
-        volume: volume.into(),
-        labels,
-        unmapped,
-    })
 }
 
 impl App {
@@ -263,7 +230,8 @@ impl App {
             .with_canvas(Some(canvas))
             .with_prevent_default(true);
         let window = Arc::new(el.create_window(attrs)?);
-        let slot = Rc::clone(&self.arriving);
+        let slot = Rc::clone(&self.arriving.slot);
+        let wake = self.arriving.wake.clone();
         wasm_bindgen_futures::spawn_local(async move {
             let ready = async {
                 let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
@@ -274,15 +242,19 @@ impl App {
                 Ok((window, surface, gpu))
             };
             *slot.borrow_mut() = Some(ready.await);
+            // The loop may be gone (the page closing): nothing to wake then.
+            if let Some(w) = wake {
+                let _ = w.send_event(());
+            }
         });
         Ok(())
     }
 
-    /// Once a frame: attaches the graphics when they arrive, runs what the page asked for
-    /// and publishes the state.
+    /// After each round of events (a frame, the device arriving): attaches the graphics
+    /// when they arrive, runs what the page asked for and publishes the state.
     pub(super) fn page_tick(&mut self) {
         if self.gfx.is_none() {
-            let arrived = self.arriving.borrow_mut().take();
+            let arrived = self.arriving.slot.borrow_mut().take();
             match arrived.map(|r| {
                 r.and_then(|(w, s, g)| {
                     let backend = match g.adapter.get_info().backend {
@@ -309,12 +281,11 @@ impl App {
                     self.ui.playing = on;
                     Ok(())
                 }
-                Command::RunTo(t) => {
-                    self.ui.playing = false;
-                    page(|p| p.running_to = Some(t));
-                    Ok(())
+                Command::Open(files) => {
+                    // A model opened meanwhile stops a run toward a time of the one before.
+                    page(|p| p.running_to = None);
+                    self.open(files)
                 }
-                Command::Open(files) => self.open(files),
             };
             if let Err(e) = r {
                 self.ui.error = Some(format!("{e:#}"));
@@ -322,9 +293,14 @@ impl App {
             }
         }
         if let Some(target) = page(|p| p.running_to) {
+            self.ui.playing = false;
             let left = target - self.sim.time();
             let r = if left > 1e-9 {
-                self.sim.step(left.min(RUN_TO_CHUNK_S))
+                let t0 = Instant::now();
+                let r = self.sim.step(left.min(RUN_TO_CHUNK_S));
+                let wall = t0.elapsed().as_secs_f64();
+                page(|p| p.run_wall_s += wall);
+                r
             } else {
                 page(|p| p.running_to = None);
                 self.sim.update_tissue().map(|_| ())
@@ -344,6 +320,10 @@ impl App {
         let frames = self.stats.frames;
         let model = self.ui.source.describe();
         let knee_px = self.knee_on_canvas();
+        let view_left = match (&self.gfx, self.ui.panel_rect) {
+            (Some(g), Some(r)) => r.max.x * g.egui_ctx.pixels_per_point(),
+            _ => 0.0,
+        };
         // performance.now() counts from the page's start.
         let now_ms = web_sys::window()
             .and_then(|w| w.performance())
@@ -360,6 +340,7 @@ impl App {
             p.frames = frames;
             p.model = model;
             p.knee_px = knee_px;
+            p.view_left_px = view_left;
         });
     }
 
@@ -383,9 +364,10 @@ impl App {
 
     /// Builds the model of `files`; on failure the running leg stays.
     fn open(&mut self, files: Vec<(String, Vec<u8>)>) -> Result<()> {
-        let src = source_of(files, self.ui.open_unmapped)?;
+        let src = ModelSource::from_files(files, self.ui.open_unmapped)?;
         let sim = src.load(SimulationConfig::default())?;
         self.switch_to(src, sim);
+        self.ui.error = None;
         page(|p| p.error = None);
         Ok(())
     }

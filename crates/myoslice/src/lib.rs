@@ -25,6 +25,7 @@ pub mod label_table;
 pub mod label_volume;
 pub mod lattice;
 pub mod muscle;
+mod par;
 pub mod phantom;
 pub mod report;
 pub mod scenario;

@@ -2,7 +2,7 @@
 
 use std::f64::consts::TAU;
 
-use rayon::prelude::*;
+use crate::par::*;
 use serde::Serialize;
 
 use crate::contour::{LabelSetMask, Mask, outermost_crossing};

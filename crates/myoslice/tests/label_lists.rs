@@ -125,4 +125,5 @@ fn files_already_read_give_the_same_volume_and_table_as_their_paths() {
     )
     .unwrap_err();
     assert!(err.to_string().contains("broken.nii"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -8,10 +8,10 @@
 //! closed tubes, even overlapping ones, is inside where any tube is), so it is right
 //! where pseudo-normals are not: where one tube's wall runs inside another.
 
+use crate::par::*;
 use glam::{IVec3, Vec3};
 use parry3d::query::PointQuery;
 use parry3d::shape::TriMesh;
-use rayon::prelude::*;
 
 use super::triangle::{Feature, closest_point};
 

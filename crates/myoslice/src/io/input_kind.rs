@@ -5,6 +5,9 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
 
+/// How much of a file is read to tell what it is.
+pub const HEAD_BYTES: usize = 4096;
+
 /// What kind of input a path holds.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum InputKind {
@@ -45,19 +48,27 @@ impl InputKind {
                 manifest,
             });
         }
-        let mut head = Vec::with_capacity(4096);
+        let mut head = Vec::with_capacity(HEAD_BYTES);
         std::fs::File::open(path)
-            .and_then(|f| f.take(4096).read_to_end(&mut head))
+            .and_then(|f| f.take(HEAD_BYTES as u64).read_to_end(&mut head))
             .map_err(|e| Error::io(path, e))?;
+        Self::sniff_head(&head, path)
+    }
+
+    /// What a file is from its first [`HEAD_BYTES`] (or all of it, if shorter) and its
+    /// name (a web page's dropped file: no file system to look in). A PNG stack's
+    /// manifest names its folder as `path`'s.
+    pub fn sniff_head(head: &[u8], path: &Path) -> Result<Self> {
+        let head = &head[..head.len().min(HEAD_BYTES)];
         if head.starts_with(&[0x1f, 0x8b])
-            || super::is_nrrd(&head)
-            || super::nifti::header_len(&head).is_some()
+            || super::is_nrrd(head)
+            || super::nifti::header_len(head).is_some()
         {
             return Ok(Self::Volume);
         }
         // Text: a scenario or a PNG stack's manifest, by their keys. Only the start was
         // read, so keys are looked for line by line rather than by parsing.
-        let text = String::from_utf8_lossy(&head);
+        let text = String::from_utf8_lossy(head);
         let text = text.trim_start_matches('\u{feff}');
         let has = |key: &str| {
             text.lines().any(|l| {
@@ -89,7 +100,7 @@ impl InputKind {
                     .any(|e| n.ends_with(e))
             });
         // Text cut inside a character at the 4 KiB mark is still text.
-        let binary = std::str::from_utf8(&head).is_err_and(|e| e.error_len().is_some());
+        let binary = std::str::from_utf8(head).is_err_and(|e| e.error_len().is_some());
         if named_volume || head.contains(&0) || binary {
             return Ok(Self::Volume);
         }

@@ -2,7 +2,7 @@
 //! increasing. A scan stored in another order is reordered voxel for voxel; an oblique
 //! one is resampled.
 
-use rayon::prelude::*;
+use crate::par::*;
 
 use super::LabelVolume;
 use crate::error::{Error, Result};

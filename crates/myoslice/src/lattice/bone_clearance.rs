@@ -6,11 +6,11 @@
 //! surface; an end cap whose walls reach into a bone comes back toward its ring.
 //! Every ring stays in its plane, so the slab volumes are corrected exactly.
 
+use crate::par::*;
 use glam::Vec3;
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::query::{PointQuery, Ray, RayCast};
 use parry3d::shape::TriMesh;
-use rayon::prelude::*;
 
 use super::checks::oriented_trimesh;
 use super::tube::{Slab, TubeMesh};

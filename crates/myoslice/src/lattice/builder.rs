@@ -2,8 +2,8 @@
 
 use std::collections::BTreeMap;
 
+use crate::par::*;
 use glam::{DVec3, Vec3};
-use rayon::prelude::*;
 
 use super::bone_clearance::{Clearance, clear_muscles_of_bone};
 use super::fat::{FatInputs, InnerContact, build_fat};

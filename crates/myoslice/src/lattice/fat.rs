@@ -1,8 +1,8 @@
 //! The fat lattice (paper, Fig. 2): hexahedra between the bone/muscle envelope and the
 //! skin, on rays from the centre of the largest bone region of each slice.
 
+use crate::par::*;
 use glam::{DVec3, Vec3};
-use rayon::prelude::*;
 
 use super::frame::SliceFrame;
 use crate::contour::{LabelSetMask, Mask, Polygon, outermost_crossing, ray_dir};

@@ -3,7 +3,7 @@
 use std::f64::consts::TAU;
 use std::sync::OnceLock;
 
-use rayon::prelude::*;
+use crate::par::*;
 
 use super::definition::{Level, PhantomDefinition};
 use crate::error::{Error, Result};

@@ -1,6 +1,6 @@
 //! The reduced slice stack: every k-th slice of a volume, optionally resampled in-plane.
 
-use rayon::prelude::*;
+use crate::par::*;
 
 use crate::error::{Error, Result};
 use crate::label_volume::LabelVolume;

@@ -4,10 +4,10 @@
 //! a condyle and hold the fat there for good). [`BoneMesh`] holds a bone's surface with
 //! its adjacency for the muscles' keep-out walks.
 
+use crate::par::*;
 use glam::{Quat, Vec3};
 use parry3d::query::PointQueryWithLocation;
 use parry3d::shape::TriMesh;
-use rayon::prelude::*;
 
 use super::distance_grid::DistanceGrid;
 use crate::body::BodyId;

@@ -9,10 +9,10 @@
 //! letting it through. Behind the knee the contact plane and the crease rule the fat
 //! (watching it there too brought more muscle out through the skin at deep flexion).
 
+use crate::par::*;
 use glam::{Quat, Vec3};
 use parry3d::query::{Ray, RayCast};
 use parry3d::shape::TriMesh;
-use rayon::prelude::*;
 
 use super::knee_fold::{FoldZone, KneeFold};
 use crate::body::{BodyId, KneeAxis};

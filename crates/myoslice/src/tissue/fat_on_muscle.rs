@@ -1,8 +1,8 @@
 //! Inner fat on its muscle: where each inner fat vertex over a muscle is pulled, and the
 //! pull (the paper's rule, with the fat gliding on the muscle's fascia).
 
+use crate::par::*;
 use glam::{Quat, Vec3};
-use rayon::prelude::*;
 
 use super::MuscleShape;
 

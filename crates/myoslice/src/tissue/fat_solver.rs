@@ -9,8 +9,8 @@
 //! goals into a buffer over the compact vertex range it touches, and the buffers are
 //! summed in chunk order. Chunks are fixed, so results do not depend on the thread count.
 
+use crate::par::*;
 use glam::{Quat, Vec3, Vec3A};
-use rayon::prelude::*;
 
 use super::fat_lanes::{LANES, RestLanes, group_pass, rest_lanes};
 

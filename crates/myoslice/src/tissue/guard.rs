@@ -8,8 +8,8 @@
 //!
 //! After the first round only what the last round moved is looked at again.
 
+use crate::par::*;
 use glam::Vec3;
-use rayon::prelude::*;
 
 use super::fat_solver::FatSolver;
 use super::intersect::{Aabb, TriangleGrid, crossing_pairs_near, crossing_pairs_of_few};

@@ -1,8 +1,8 @@
 //! Exact(-enough) self-intersection test of a triangle surface: does any triangle cross
 //! another one it shares no vertex with?
 
+use crate::par::*;
 use glam::{UVec3, Vec3, Vec3A};
-use rayon::prelude::*;
 
 use crate::geometry::triangles_cross;
 

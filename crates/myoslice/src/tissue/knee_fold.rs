@@ -15,8 +15,8 @@
 //! height blend, whose angular derivative vanishes there. The map is therefore
 //! orientation-preserving everywhere: it is the tissue's always-valid fallback shape.
 
+use crate::par::*;
 use glam::{Quat, Vec3};
-use rayon::prelude::*;
 
 use crate::body::KneeAxis;
 use crate::lattice::{hex_volume_f32, hex_volume_points};

@@ -5,7 +5,7 @@ use std::sync::OnceLock;
 use glam::{Mat3, Vec3};
 
 use super::Tissue;
-use rayon::prelude::*;
+use crate::par::*;
 
 use super::polar::{covariance, polar_rotation_exact, rotation_step};
 use crate::lattice::{hex_is_valid, hex_volume_f32, quad_area};

@@ -32,9 +32,9 @@ mod update_back;
 
 use std::sync::Arc;
 
+use crate::par::*;
 use glam::{Quat, Vec3};
 use parry3d::shape::TriMesh;
-use rayon::prelude::*;
 
 pub use fat_solver::FatSolver;
 pub use guard_tally::GuardTally;

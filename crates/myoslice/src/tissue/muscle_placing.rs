@@ -6,8 +6,8 @@
 
 use web_time::Instant;
 
+use crate::par::*;
 use glam::Quat;
-use rayon::prelude::*;
 
 use super::bone_keep_out::{self, Bones};
 use super::knee_fold::{Contact, KneeFold};

@@ -1,8 +1,8 @@
 //! How far muscles and bones reach where they should not: muscles into bone, muscles and
 //! bones out through the skin. Exact, for checks and tests, not for every update.
 
+use crate::par::*;
 use glam::Vec3;
-use rayon::prelude::*;
 
 use super::bone_keep_out::Bones;
 use super::{BoneOverlap, SkinBreach, Tissue, bone_overlap};

@@ -2,9 +2,9 @@
 //! lattice, and each muscle vertex measured against it (exact: a tree query per vertex;
 //! for checks, not for every update).
 
+use crate::par::*;
 use glam::Vec3;
 use parry3d::query::PointQuery;
-use rayon::prelude::*;
 
 use crate::lattice::{FatLattice, oriented_trimesh};
 

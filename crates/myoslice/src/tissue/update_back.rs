@@ -42,7 +42,7 @@ impl Tissue {
                 layers,
                 placed: None,
             };
-            let (back, r) = rayon::join(
+            let (back, r) = crate::par::join(
                 || {
                     let start = web_time::Instant::now();
                     (self.update_back(front), start.elapsed())
