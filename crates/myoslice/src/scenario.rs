@@ -612,6 +612,11 @@ mod tests {
         Scenario::from_str_at(t, Path::new("test.toml"))
     }
 
+    /// The message of the error `t` gives.
+    fn parse_err(t: &str) -> String {
+        parse(t).unwrap_err().to_string()
+    }
+
     #[test]
     fn a_minimal_scenario_parses_with_defaults() {
         let s = parse(
@@ -626,49 +631,35 @@ mod tests {
 
     #[test]
     fn bad_scenarios_name_the_problem() {
-        let e = parse("[simulation]\nduration_s = 0.5\nbogus = 1\n")
-            .unwrap_err()
-            .to_string();
+        let e = parse_err("[simulation]\nduration_s = 0.5\nbogus = 1\n");
         assert!(e.contains("bogus") && e.contains("line 3"), "{e}");
-        let e = parse("[simulation]\nduration_s = \"long\"\n")
-            .unwrap_err()
-            .to_string();
+        let e = parse_err("[simulation]\nduration_s = \"long\"\n");
         assert!(e.contains("duration_s"), "{e}");
-        let e = parse("[simulation]\nduration_s = -1\n")
-            .unwrap_err()
-            .to_string();
+        let e = parse_err("[simulation]\nduration_s = -1\n");
         assert!(e.contains("duration_s") && e.contains("line 2"), "{e}");
-        let e = parse("[model]\nsource = \"nifti\"\nvolume = \"nope.nii\"\nlabels = \"nope.json\"\n[simulation]\nduration_s = 1\n").unwrap_err().to_string();
+        let e = parse_err(
+            "[model]\nsource = \"nifti\"\nvolume = \"nope.nii\"\nlabels = \"nope.json\"\n[simulation]\nduration_s = 1\n",
+        );
         assert!(e.contains("model.volume") && e.contains("not found"), "{e}");
-        let e = parse(
+        let e = parse_err(
             "[model]\nsource = \"phantom\"\nnames = \"n.toml\"\n[simulation]\nduration_s = 1\n",
-        )
-        .unwrap_err()
-        .to_string();
+        );
         assert!(
             e.contains("model.names (line 3)") && e.contains("only for"),
             "{e}"
         );
-        let e = parse("[model]\nsource = \"nifti\"\n[simulation]\nduration_s = 1\n")
-            .unwrap_err()
-            .to_string();
+        let e = parse_err("[model]\nsource = \"nifti\"\n[simulation]\nduration_s = 1\n");
         assert!(e.contains("model.volume is required"), "{e}");
-        let e = parse("[simulation]\nduration_s = 1\n[excitation]\nx = [[0.0, 2.0]]\n")
-            .unwrap_err()
-            .to_string();
+        let e = parse_err("[simulation]\nduration_s = 1\n[excitation]\nx = [[0.0, 2.0]]\n");
         assert!(e.contains("excitation.x"), "{e}");
-        let e = parse(
+        let e = parse_err(
             "[simulation]\nduration_s = 1\nchain_tether = 600\nchain_tether_release_n = -5\n",
-        )
-        .unwrap_err()
-        .to_string();
+        );
         assert!(
             e.contains("simulation.chain_tether_release_n = -5") && e.contains("line 4"),
             "{e}"
         );
-        let e = parse("[simulation]\nduration_s = 1\nchain_tether = nan\n")
-            .unwrap_err()
-            .to_string();
+        let e = parse_err("[simulation]\nduration_s = 1\nchain_tether = nan\n");
         assert!(
             e.contains("simulation.chain_tether = NaN") && e.contains("line 3"),
             "{e}"
@@ -685,9 +676,7 @@ mod tests {
             s.excitation["hamstrings"].points(),
             &[(0.0, 0.4 * 1.5), (0.2, 1.0)]
         );
-        let e = parse("[simulation]\nduration_s = 1\nexcitation_scale = -1\n")
-            .unwrap_err()
-            .to_string();
+        let e = parse_err("[simulation]\nduration_s = 1\nexcitation_scale = -1\n");
         assert!(
             e.contains("excitation_scale = -1") && e.contains("line 3"),
             "{e}"
@@ -707,16 +696,13 @@ mod tests {
             ),
             (1.5, 1.0, 1.0)
         );
-        let e = parse("[simulation]\nduration_s = 1\n[muscle.hamstrings]\nmax_force_scale = 0\n")
-            .unwrap_err()
-            .to_string();
+        let e =
+            parse_err("[simulation]\nduration_s = 1\n[muscle.hamstrings]\nmax_force_scale = 0\n");
         assert!(
             e.contains("muscle.hamstrings.max_force_scale") && e.contains("line 3"),
             "{e}"
         );
-        let e = parse("[simulation]\nduration_s = 1\n[muscle.hamstrings]\nforce = 2\n")
-            .unwrap_err()
-            .to_string();
+        let e = parse_err("[simulation]\nduration_s = 1\n[muscle.hamstrings]\nforce = 2\n");
         assert!(e.contains("force"), "{e}");
     }
 
