@@ -3,7 +3,8 @@
 # (default target/web). Serve the folder with any static server, e.g.
 #   python3 -m http.server -d target/web 8000   # then open http://127.0.0.1:8000
 # Installs what it needs on first use: the wasm32 target (rustup) and wasm-bindgen-cli at
-# the version of the wasm-bindgen crate in Cargo.lock (into the target folder's tools/).
+# the version of the wasm-bindgen crate in Cargo.lock (into ~/.cache/myoslice/tools, kept
+# across clones: it takes minutes to build).
 # MYOSLICE_WASM_OPT=1 also shrinks the wasm with binaryen's wasm-opt (a recent one).
 # Usage: scripts/web.sh [DIR]
 set -euo pipefail
@@ -21,11 +22,12 @@ rustup target list --installed | grep -qx wasm32-unknown-unknown \
 # The CLI must be the exact version of the crate the wasm was built with.
 version=$(awk '/^name = "wasm-bindgen"$/ { getline; gsub(/"/, "", $3); print $3; exit }' Cargo.lock)
 [ -n "$version" ] || { echo "no wasm-bindgen in Cargo.lock" >&2; exit 1; }
-bindgen="$target/tools/bin/wasm-bindgen"
+tools=${XDG_CACHE_HOME:-$HOME/.cache}/myoslice/tools/wasm-bindgen-$version
+bindgen="$tools/bin/wasm-bindgen"
 if ! "$bindgen" --version 2>/dev/null | grep -q " $version\$"; then
-  echo "installing wasm-bindgen-cli $version into $target/tools"
+  echo "installing wasm-bindgen-cli $version into $tools"
   # Not --locked: its lock file names a release the registry no longer serves.
-  cargo install --quiet wasm-bindgen-cli --version "$version" --root "$target/tools"
+  cargo install --quiet wasm-bindgen-cli --version "$version" --root "$tools"
 fi
 
 # The viewer's library as a cdylib (natively it stays an rlib); no debug info in the page.
