@@ -461,24 +461,28 @@ impl Scenario {
     /// serves the other (sweeps build each model once per process).
     pub fn lattice_key(&self) -> String {
         let m = &self.model;
-        // Each file by its full path, size and modification time: an edited file is a
-        // new model.
-        let file = |p: &Option<PathBuf>| {
-            p.as_ref().map(|p| {
-                let full = resolve(&self.path, p);
-                let full = std::fs::canonicalize(&full).unwrap_or(full);
-                let meta = std::fs::metadata(&full).ok();
-                (
-                    full,
-                    meta.as_ref().map(std::fs::Metadata::len),
-                    meta.and_then(|m| m.modified().ok()),
-                )
-            })
+        // Each file read by its full path, size and modification time: an edited file
+        // is a new model (a volume's detached data file or PNG slices too).
+        let stamp = |full: PathBuf| {
+            let full = std::fs::canonicalize(&full).unwrap_or(full);
+            let meta = std::fs::metadata(&full).ok();
+            (
+                full,
+                meta.as_ref().map(std::fs::Metadata::len),
+                meta.and_then(|m| m.modified().ok()),
+            )
         };
+        let file = |p: &Option<PathBuf>| p.as_ref().map(|p| stamp(resolve(&self.path, p)));
+        let volume: Option<Vec<_>> = m.volume.as_ref().map(|p| {
+            crate::io::input_files(resolve(&self.path, p))
+                .into_iter()
+                .map(stamp)
+                .collect()
+        });
         format!(
             "{}|{:?}|{:?}|{:?}|{:?}|{:?}",
             m.source,
-            file(&m.volume),
+            volume,
             file(&m.labels),
             file(&m.names),
             m.unmapped,

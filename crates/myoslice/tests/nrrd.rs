@@ -81,6 +81,11 @@ fn gzip_big_endian_and_detached_data_read_the_same_voxels() {
     )
     .unwrap();
     assert_eq!(read_nrrd(dir.join("leg.nhdr")).unwrap().volume, want);
+    // What a cache must watch: the header and its data file.
+    assert_eq!(
+        myoslice::io::input_files(dir.join("leg.nhdr")),
+        [dir.join("leg.nhdr"), dir.join("leg.raw")]
+    );
     // `spacings` instead of space directions.
     let sp = nrrd(
         "type: short\ndimension: 3\nsizes: 3 2 4\nspacings: 2 1 5\nencoding: raw\nendian: little\n",

@@ -121,6 +121,20 @@ fn table_of(
     })
 }
 
+/// Every file that reading `path` as [`read_input`] does touches: the volume itself, a
+/// detached NRRD's data file, or a PNG stack's manifest, label file and slices. For
+/// telling an edited input from the one something was built from (a cache's key); what
+/// cannot be looked at is left out, and reading the input says why.
+pub fn input_files(path: impl AsRef<std::path::Path>) -> Vec<std::path::PathBuf> {
+    let path = path.as_ref();
+    match InputKind::sniff(path) {
+        Ok(InputKind::PngStack { folder, manifest }) => png_stack::stack_files(&folder, &manifest),
+        _ => std::iter::once(path.to_path_buf())
+            .chain(nrrd::detached_data_file(path))
+            .collect(),
+    }
+}
+
 /// A label volume and its table from any input myoslice reads, told apart by content
 /// ([`InputKind::sniff`]): a label volume read as [`read_segmentation`] does, or a PNG
 /// stack (its folder or its manifest; the manifest names the labels, so `labels` must be

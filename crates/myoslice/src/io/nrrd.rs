@@ -12,7 +12,7 @@
 
 use std::collections::BTreeMap;
 use std::io::Read;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::{LabelNames, MAX_VOLUME_BYTES};
 use crate::error::{Error, Result};
@@ -46,6 +46,23 @@ pub fn parse_nrrd(raw: &[u8], path: &Path) -> Result<NrrdVolume> {
         Some(f) => read_detached(&path.parent().unwrap_or(Path::new(".")).join(f), &h)?.into(),
     };
     h.volume(&payload).map_err(err)
+}
+
+/// How much of a file [`detached_data_file`] reads for its header (a segmentation's
+/// header names every segment: tens of kilobytes).
+const HEADER_READ_BYTES: u64 = 1 << 20;
+
+/// The detached data file the NRRD header at `path` names, if it names one (the header
+/// alone is read); None too where `path` is not a readable NRRD header.
+pub(crate) fn detached_data_file(path: &Path) -> Option<PathBuf> {
+    let mut head = Vec::new();
+    std::fs::File::open(path)
+        .ok()?
+        .take(HEADER_READ_BYTES)
+        .read_to_end(&mut head)
+        .ok()?;
+    let f = Header::parse(&head).ok()?.data_file?;
+    Some(path.parent().unwrap_or(Path::new(".")).join(f))
 }
 
 /// A detached data file, read no further than the header's voxels can reach: a regular

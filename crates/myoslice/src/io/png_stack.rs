@@ -78,6 +78,33 @@ fn parse_color(s: &str) -> Option<[u8; 3]> {
     Some([(v >> 16) as u8, (v >> 8) as u8, v as u8])
 }
 
+/// The `.png` slices of `folder`, in reading order (by name).
+fn slice_files(folder: &Path) -> Result<Vec<PathBuf>> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(folder)
+        .map_err(|e| Error::io(folder, e))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")))
+        .collect();
+    files.sort();
+    Ok(files)
+}
+
+/// Every file reading the stack touches: its manifest, the label file the manifest
+/// names, and its slices. Only the manifest is read; what cannot be looked at is left
+/// out (reading the stack says why).
+pub(crate) fn stack_files(folder: &Path, manifest: &Path) -> Vec<PathBuf> {
+    let mut files = vec![manifest.to_path_buf()];
+    let labels_file = std::fs::read_to_string(manifest)
+        .ok()
+        .and_then(|text| toml::from_str::<Manifest>(&text).ok())
+        .and_then(|m| m.labels_file);
+    if let Some(f) = labels_file {
+        files.push(manifest.parent().unwrap_or(folder).join(f));
+    }
+    files.extend(slice_files(folder).unwrap_or_default());
+    files
+}
+
 /// Reads a PNG slice folder; `manifest` defaults to `folder/manifest.toml`.
 pub fn read_png_stack(
     folder: impl AsRef<Path>,
@@ -140,12 +167,7 @@ pub fn read_png_stack_with(
         })?;
         colors.insert(c, *id);
     }
-    let mut files: Vec<PathBuf> = std::fs::read_dir(folder)
-        .map_err(|e| Error::io(folder, e))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")))
-        .collect();
-    files.sort();
+    let files = slice_files(folder)?;
     if files.is_empty() {
         return Err(Error::Png {
             path: folder.into(),
@@ -341,6 +363,31 @@ kind = "bone"
         assert_eq!(v.get(2, 1, 2), 2);
         assert_eq!(v.spacing_mm(), [0.5, 0.5, 2.0]);
         assert_eq!(t.labels().len(), 2);
+        std::fs::remove_dir_all(&d).ok();
+    }
+
+    #[test]
+    fn a_stacks_input_files_are_its_manifest_label_file_and_slices() {
+        let d = tmp("files");
+        std::fs::write(
+            d.join("manifest.toml"),
+            "pixel_size_mm = 1\nslice_interval_mm = 1\nlabels_file = \"labels.json\"\n",
+        )
+        .unwrap();
+        for name in ["b.png", "a.PNG", "notes.txt"] {
+            std::fs::write(d.join(name), b"").unwrap();
+        }
+        assert_eq!(
+            crate::io::input_files(&d),
+            ["manifest.toml", "labels.json", "a.PNG", "b.png"].map(|f| d.join(f))
+        );
+        // Given by its manifest, the same.
+        assert_eq!(
+            crate::io::input_files(d.join("manifest.toml")).len(),
+            4,
+            "{:?}",
+            crate::io::input_files(d.join("manifest.toml"))
+        );
         std::fs::remove_dir_all(&d).ok();
     }
 
