@@ -14,13 +14,15 @@ use winit::event_loop::{ControlFlow, EventLoop};
 use winit::window::{Window, WindowId};
 
 use crate::camera::{CameraPreset, OrbitCamera};
+pub use crate::frame_stats::FrameStats;
 use crate::gpu::Gpu;
 use crate::model::ModelSource;
 use crate::pick::{Ray, pick_muscle};
-use crate::render::{DEPTH, RenderSettings, Renderer};
+use crate::render::{RenderSettings, Renderer};
 use crate::scene::{SceneMesh, SceneOptions};
 use crate::touch::{Gesture, Touches};
 use crate::ui::{UiAction, UiState};
+use crate::window_gfx::{Gfx, targets, view_format};
 
 /// How far (px) the pointer may move between press and release and still be a click.
 const CLICK_SLOP_PX: f64 = 4.0;
@@ -31,44 +33,6 @@ pub struct RunOptions {
     /// Close by itself after this many frames and print their timing (smoke tests,
     /// frame-time measurements); `None` runs until the window is closed.
     pub exit_after_frames: Option<u64>,
-}
-
-/// Frame-time figures of a session.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct FrameStats {
-    /// Frames presented.
-    pub frames: u64,
-    /// The first frame (ms): start-up, pipeline compilation.
-    pub first_ms: f64,
-    /// Wall time of the frames after the first (s).
-    pub wall_s: f64,
-    /// Of which simulating (s).
-    pub sim_s: f64,
-    /// Slowest frame after the first (ms).
-    pub worst_ms: f64,
-}
-
-impl FrameStats {
-    fn add(&mut self, frame_s: f64, sim_s: f64) {
-        if self.frames == 0 {
-            self.first_ms = frame_s * 1e3;
-        } else {
-            self.worst_ms = self.worst_ms.max(frame_s * 1e3);
-            self.wall_s += frame_s;
-            self.sim_s += sim_s;
-        }
-        self.frames += 1;
-    }
-
-    /// Mean frame time after the first (ms).
-    pub fn mean_ms(&self) -> f64 {
-        1e3 * self.wall_s / self.frames.saturating_sub(1).max(1) as f64
-    }
-
-    /// Mean simulation time per frame after the first (ms).
-    pub fn mean_sim_ms(&self) -> f64 {
-        1e3 * self.sim_s / self.frames.saturating_sub(1).max(1) as f64
-    }
 }
 
 /// Opens the window on a model (or a scenario) and runs until it is closed (or for
@@ -113,19 +77,6 @@ fn load(source: &ModelSource, scenario: Option<&PathBuf>) -> Result<Simulation> 
     source.load(SimulationConfig::default())
 }
 
-struct Gfx {
-    window: Arc<Window>,
-    surface: wgpu::Surface<'static>,
-    gpu: Gpu,
-    config: wgpu::SurfaceConfiguration,
-    renderer: Renderer,
-    msaa: Option<wgpu::TextureView>,
-    depth: wgpu::TextureView,
-    egui_ctx: egui::Context,
-    egui_state: egui_winit::State,
-    egui_renderer: egui_wgpu::Renderer,
-}
-
 struct App {
     /// The instance the window's surface comes from (a page makes its own once the
     /// browser says whether it has WebGPU).
@@ -150,51 +101,6 @@ struct App {
     fatal: Option<anyhow::Error>,
     opts: RunOptions,
     stats: FrameStats,
-}
-
-/// The format the frame is drawn in: the surface's, or its sRGB view's.
-fn view_format(config: &wgpu::SurfaceConfiguration) -> wgpu::TextureFormat {
-    config
-        .view_formats
-        .first()
-        .copied()
-        .unwrap_or(config.format)
-}
-
-fn targets(
-    gpu: &Gpu,
-    config: &wgpu::SurfaceConfiguration,
-    samples: u32,
-) -> (Option<wgpu::TextureView>, wgpu::TextureView) {
-    let tex = |format, usage, label| {
-        gpu.device
-            .create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: config.width,
-                    height: config.height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: samples,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-            .create_view(&wgpu::TextureViewDescriptor::default())
-    };
-    let msaa = (samples > 1).then(|| {
-        tex(
-            view_format(config),
-            wgpu::TextureUsages::RENDER_ATTACHMENT,
-            "msaa",
-        )
-    });
-    (
-        msaa,
-        tex(DEPTH, wgpu::TextureUsages::RENDER_ATTACHMENT, "depth"),
-    )
 }
 
 impl App {

@@ -15,9 +15,13 @@ pub mod scene;
 #[cfg(feature = "window")]
 pub mod app;
 #[cfg(feature = "window")]
+pub mod frame_stats;
+#[cfg(feature = "window")]
 pub mod touch;
 #[cfg(feature = "window")]
 pub mod ui;
+#[cfg(feature = "window")]
+mod window_gfx;
 
 pub use camera::{CameraPreset, OrbitCamera};
 pub use capture::{CaptureOptions, capture_frames, capture_png};

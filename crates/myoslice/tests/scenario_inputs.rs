@@ -1,6 +1,8 @@
 //! A scenario's model is known by every file its volume is read from: a cache keyed by
 //! [`Scenario::lattice_key`] must not hand back a leg built from an older file.
 
+#![allow(clippy::unwrap_used)] // tests fail loudly by design
+
 use std::path::PathBuf;
 
 use myoslice::prelude::*;
