@@ -61,20 +61,7 @@ impl Offscreen {
     pub fn new(gpu: &Gpu, width: u32, height: u32) -> Self {
         let samples = gpu.msaa_samples(CAPTURE_FORMAT);
         let tex = |format, samples, usage, label| {
-            gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: samples,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
+            gpu.target((width, height), format, samples, usage, label)
         };
         let color = tex(
             CAPTURE_FORMAT,

@@ -101,4 +101,29 @@ impl Gpu {
             .find(|&n| f.sample_count_supported(n))
             .unwrap_or(1)
     }
+
+    /// A 2D render target of `size` (px) with `samples` samples per pixel.
+    pub fn target(
+        &self,
+        (width, height): (u32, u32),
+        format: wgpu::TextureFormat,
+        samples: u32,
+        usage: wgpu::TextureUsages,
+        label: &str,
+    ) -> wgpu::Texture {
+        self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: samples,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        })
+    }
 }

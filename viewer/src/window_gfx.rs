@@ -39,21 +39,7 @@ pub(crate) fn targets(
     samples: u32,
 ) -> (Option<wgpu::TextureView>, wgpu::TextureView) {
     let tex = |format, usage, label| {
-        gpu.device
-            .create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: config.width,
-                    height: config.height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: samples,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
+        gpu.target((config.width, config.height), format, samples, usage, label)
             .create_view(&wgpu::TextureViewDescriptor::default())
     };
     let msaa = (samples > 1).then(|| {
