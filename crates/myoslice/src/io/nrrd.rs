@@ -55,12 +55,14 @@ const HEADER_READ_BYTES: u64 = 1 << 20;
 /// The detached data file the NRRD header at `path` names, if it names one (the header
 /// alone is read); None too where `path` is not a readable NRRD header.
 pub(crate) fn detached_data_file(path: &Path) -> Option<PathBuf> {
+    let mut file = std::fs::File::open(path).ok()?;
     let mut head = Vec::new();
-    std::fs::File::open(path)
-        .ok()?
-        .take(HEADER_READ_BYTES)
-        .read_to_end(&mut head)
-        .ok()?;
+    // The magic line first: a NIfTI (or any other file) is read no further.
+    (&mut file).take(8).read_to_end(&mut head).ok()?;
+    if !is_nrrd(&head) {
+        return None;
+    }
+    file.take(HEADER_READ_BYTES).read_to_end(&mut head).ok()?;
     let f = Header::parse(&head).ok()?.data_file?;
     Some(path.parent().unwrap_or(Path::new(".")).join(f))
 }
