@@ -5,19 +5,13 @@
 
 mod common;
 
+use common::scratch;
 use common::tool_files::{itk_snap, slicer};
 
 use std::path::Path;
 
 use myoslice::label_names::Unmapped;
 use myoslice::{LabelTable, TissueKind};
-
-/// A fresh folder of this test process under the system's temporary folder.
-fn scratch(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("myoslice-labels-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// `table` written by each tool, read back: the same ids, names and kinds, and the
 /// same attachments where `table` has them.
@@ -47,7 +41,7 @@ fn reads_back(table: &LabelTable, dir: &Path) {
 #[test]
 fn the_phantoms_labels_written_by_itk_snap_and_slicer_read_back_as_its_table() {
     let (_, table) = myoslice::phantom::Phantom::default().generate().unwrap();
-    let dir = scratch("phantom");
+    let dir = scratch("labels-phantom");
     reads_back(&table, &dir);
     std::fs::remove_dir_all(dir).unwrap();
 }
@@ -57,14 +51,14 @@ fn the_visible_human_labels_written_by_itk_snap_and_slicer_read_back_as_its_tabl
     let Some((_, table)) = common::vh_leg() else {
         return;
     };
-    let dir = scratch("vh");
+    let dir = scratch("labels-vh");
     reads_back(&table, &dir);
     std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
 fn unknown_names_are_refused_by_default_and_taken_as_asked_otherwise() {
-    let dir = scratch("unknown");
+    let dir = scratch("labels-unknown");
     let path = dir.join("seg.txt");
     std::fs::write(
         &path,
@@ -95,7 +89,7 @@ fn unknown_names_are_refused_by_default_and_taken_as_asked_otherwise() {
 fn files_already_read_give_the_same_volume_and_table_as_their_paths() {
     // As a web page hands them over: bytes and names, no file system.
     let (volume, table) = myoslice::phantom::Phantom::default().generate().unwrap();
-    let dir = scratch("bytes");
+    let dir = scratch("labels-bytes");
     let nii = myoslice::io::encode_nifti(&volume);
     std::fs::write(dir.join("leg.nii"), &nii).unwrap();
     let texts: [(&str, String); 2] = [

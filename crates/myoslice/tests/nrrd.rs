@@ -4,19 +4,16 @@
 
 #![allow(clippy::unwrap_used)] // tests fail loudly by design
 
-use std::io::Write as _;
-use std::path::{Path, PathBuf};
+mod common;
 
+use std::io::Write as _;
+use std::path::Path;
+
+use common::scratch;
 use myoslice::io::{parse_nrrd, read_label_volume, read_nrrd, read_segmentation};
 use myoslice::label_names::Unmapped;
 use myoslice::prelude::*;
 use proptest::prelude::*;
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("myoslice-nrrd-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// A 3 × 2 × 4 volume of labels 0..=5 with 2 mm × 1 mm × 5 mm voxels.
 fn small() -> (Vec<u16>, [usize; 3]) {
@@ -71,7 +68,7 @@ fn gzip_big_endian_and_detached_data_read_the_same_voxels() {
         &gzip(&be),
     );
     assert_eq!(parse_nrrd(&gz, Path::new("a.nrrd")).unwrap().volume, want);
-    let dir = scratch("detached");
+    let dir = scratch("nrrd-detached");
     std::fs::write(dir.join("leg.raw"), &le).unwrap();
     std::fs::write(
         dir.join("leg.nhdr"),
@@ -110,7 +107,7 @@ fn a_slicer_segmentation_merges_its_layers_and_names_its_segments() {
          Segment2_Name:=Subcutaneous fat\nSegment2_LabelValue:=2\nSegment2_Layer:=0\n",
         &data,
     );
-    let dir = scratch("seg");
+    let dir = scratch("nrrd-seg");
     let path = dir.join("leg.seg.nrrd");
     std::fs::write(&path, &raw).unwrap();
     let v = read_nrrd(&path).unwrap();
@@ -187,7 +184,7 @@ fn skipped_lines_and_bytes_are_skipped_where_the_format_says() {
 fn a_plain_label_map_without_names_needs_a_label_file() {
     let (data, _) = small();
     let bytes: Vec<u8> = data.iter().map(|v| *v as u8).collect();
-    let dir = scratch("plain");
+    let dir = scratch("nrrd-plain");
     let path = dir.join("map.nrrd");
     std::fs::write(
         &path,
@@ -254,7 +251,7 @@ fn the_phantom_written_as_nrrd_reads_back_identical() {
         ),
         &sagittal,
     );
-    let dir_ = scratch("sagittal");
+    let dir_ = scratch("nrrd-sagittal");
     let path = dir_.join("sagittal.nrrd");
     std::fs::write(&path, &raw).unwrap();
     let (read, _) = read_label_volume(&path).unwrap();

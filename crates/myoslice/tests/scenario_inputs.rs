@@ -3,20 +3,14 @@
 
 #![allow(clippy::unwrap_used)] // tests fail loudly by design
 
-use std::path::PathBuf;
+mod common;
 
+use common::scratch;
 use myoslice::prelude::*;
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("myoslice-inputs-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 #[test]
 fn an_edited_detached_data_file_makes_a_new_lattice_key() {
-    let dir = scratch("nhdr");
+    let dir = scratch("inputs-nhdr");
     std::fs::write(
         dir.join("leg.nhdr"),
         "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: leg.raw\n",

@@ -10,6 +10,14 @@ use std::sync::OnceLock;
 use myoslice::muscle::MuscleCatalogue;
 use myoslice::prelude::*;
 
+/// A fresh, empty folder of this test process under the system's temporary folder.
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("myoslice-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 /// `../shared/data/visible-human/` relative to the workspace.
 pub fn vh_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/visible-human")
