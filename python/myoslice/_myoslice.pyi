@@ -289,6 +289,16 @@ class Simulation:
         ``deepest_m`` (float32, m); empty arrays without tissue. Exact (a tree query per
         vertex near a bone): tens of milliseconds, for checks rather than every frame."""
 
+    def audit(self) -> dict[str, Any] | None:
+        """Every soundness check of the tissue now, measured as a user's tools do: a dict
+        shaped as ``summary.json``'s ``audit`` (``folded_fat``: hexahedra with a corner
+        Jacobian at or below zero; ``fat_under_half_volume``; ``min_fat_volume_ratio``;
+        ``muscles_out_of_skin`` and ``bones_out_of_skin``: ``{vertices_over_1mm,
+        farthest_m}``, None where the skin cannot be closed; ``muscles_in_bone`` and
+        ``muscles_in_muscles``: ``{vertices_over_1mm, deepest_m}``; ``skin_crossings``;
+        ``muscle_volume_ratio``: [smallest, largest]; ``fat_off_rest_m``; ``finite``).
+        None without tissue. Exact: about a second on a whole leg."""
+
     def muscles_outside_skin(self) -> _OutsideSkin:
         """How far each muscle's surface reaches out through the skin now, in
         :attr:`muscle_names` order: ``vertices_over_1mm`` (int64, vertices more than 1 mm

@@ -504,6 +504,20 @@ impl PySimulation {
         Ok(d)
     }
 
+    /// Every soundness check of the tissue now (folded and squashed fat, muscles and
+    /// bones out through the skin, muscles in bone and in one another, skin crossings,
+    /// muscle volumes, the fat's distance from rest): a dict shaped as `summary.json`'s
+    /// audit, None without tissue. Exact, about a second on a whole leg.
+    fn audit<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let sim = &self.sim;
+        let Some(a) = crate::pool::detach(py, || sim.audit()) else {
+            return Ok(None);
+        };
+        let json = serde_json::to_string(&a)
+            .map_err(|e| py_err(py, Kind::Simulation, format!("audit: {e}")))?;
+        py.import("json")?.call_method1("loads", (json,)).map(Some)
+    }
+
     /// How far each muscle's surface reaches into bone now: a dict of per-muscle arrays
     /// `vertices_over_1mm` (int64) and `deepest_m` (float32), empty without tissue.
     fn muscles_in_bone<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {

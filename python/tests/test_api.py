@@ -267,6 +267,23 @@ def test_muscles_outside_skin_per_muscle(tissue: Simulation, rigid: Simulation) 
     assert empty["vertices_over_1mm"].shape == (0,) and empty["farthest_m"].shape == (0,)
 
 
+def test_audit_sums_the_per_muscle_measures(tissue: Simulation, rigid: Simulation) -> None:
+    flex(tissue, 0.3)
+    a = tissue.audit()
+    assert a is not None and a["finite"] is True
+    out = tissue.muscles_outside_skin()
+    assert a["muscles_out_of_skin"]["vertices_over_1mm"] == int(out["vertices_over_1mm"].sum())
+    assert a["muscles_out_of_skin"]["farthest_m"] == pytest.approx(float(out["farthest_m"].max()))
+    bone = tissue.muscles_in_bone()
+    assert a["muscles_in_bone"]["vertices_over_1mm"] == int(bone["vertices_over_1mm"].sum())
+    # Folded fat is counted by corner Jacobians, as the tissue metrics count it.
+    assert a["folded_fat"] >= 0 and 0.0 < a["min_fat_volume_ratio"] <= 1.0
+    assert a["muscles_in_muscles"]["deepest_m"] >= 0.0
+    lo, hi = a["muscle_volume_ratio"]
+    assert 0.0 < lo <= hi
+    assert rigid.audit() is None
+
+
 def test_bones_outside_skin_per_bone(tissue: Simulation, rigid: Simulation) -> None:
     r = tissue.bones_outside_skin()
     assert set(r) == {"vertices_over_1mm", "farthest_m"}

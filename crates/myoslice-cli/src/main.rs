@@ -59,6 +59,11 @@ struct RunArgs {
     /// Override the scenario's duration (s), e.g. for a quick check.
     #[arg(long)]
     duration: Option<f64>,
+    /// Audit the tissue after every update (`audit.csv`; about a second an update): folded
+    /// and squashed fat, muscles and bones out through the skin, muscles in bone and in
+    /// one another, skin crossings.
+    #[arg(long)]
+    audit: bool,
 }
 
 #[derive(Args)]
@@ -297,6 +302,7 @@ fn run_scenario(a: &RunArgs) -> Result<()> {
         );
         sc.simulation.duration_s = d;
     }
+    sc.output.audit |= a.audit;
     let bar = if a.quiet {
         indicatif::ProgressBar::hidden()
     } else {
@@ -341,8 +347,74 @@ fn run_scenario(a: &RunArgs) -> Result<()> {
             summary.guard.updates,
             summary.guard.vertices
         );
+        if let Some(r) = &summary.audit {
+            print_audit(r);
+        }
     }
     Ok(())
+}
+
+/// The worst of each tissue check over an audited run, and where it ended.
+fn print_audit(r: &myoslice::export::RunAudit) {
+    let breach = |b: Option<myoslice::tissue::SkinBreach>| {
+        b.map_or("unmeasured (skin not closed)".to_string(), |b| {
+            format!(
+                "{} (farthest {:.1} mm)",
+                b.vertices_over_1mm,
+                b.farthest_m * 1e3
+            )
+        })
+    };
+    let (w, l) = (&r.worst, &r.last);
+    println!("audit of {} tissue updates, worst (last):", r.updates);
+    println!(
+        "  folded fat elements          {} ({})",
+        w.folded_fat, l.folded_fat
+    );
+    println!(
+        "  fat elements under half      {} ({}), smallest volume ratio {:.3} ({:.3})",
+        w.fat_under_half_volume,
+        l.fat_under_half_volume,
+        w.min_fat_volume_ratio,
+        l.min_fat_volume_ratio
+    );
+    println!(
+        "  muscle vertices out of skin  {} ({})",
+        breach(w.muscles_out_of_skin),
+        breach(l.muscles_out_of_skin)
+    );
+    println!(
+        "  bone vertices out of skin    {} ({})",
+        breach(w.bones_out_of_skin),
+        breach(l.bones_out_of_skin)
+    );
+    for (name, a, b) in [
+        (
+            "in bone   ",
+            w.muscles_in_bone.vertices_over_1mm,
+            w.muscles_in_bone.deepest_m,
+        ),
+        (
+            "in muscle ",
+            w.muscles_in_muscles.vertices_over_1mm,
+            w.muscles_in_muscles.deepest_m,
+        ),
+    ] {
+        println!("  muscle vertices {name}   {a} (deepest {:.1} mm)", b * 1e3);
+    }
+    println!(
+        "  skin crossings               {} ({})",
+        w.skin_crossings, l.skin_crossings
+    );
+    println!(
+        "  muscle volume ratio          {:.3}..{:.3}",
+        w.muscle_volume_ratio[0], w.muscle_volume_ratio[1]
+    );
+    println!(
+        "  fat off its rest place       {:.1} mm ({:.1} mm at the end)",
+        w.fat_off_rest_m * 1e3,
+        l.fat_off_rest_m * 1e3
+    );
 }
 
 fn probe(a: &ProbeArgs) -> Result<()> {

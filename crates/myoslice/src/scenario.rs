@@ -39,6 +39,7 @@
 //! frames = 30                 # output frames over the run (default 25)
 //! vtu = true                  # ParaView series (default true)
 //! glb = true                  # animated glTF for Blender (default true)
+//! audit = false               # every tissue check after each update, audit.csv (slow)
 //! ```
 //!
 //! Groups: `flexors`, `extensors`, `hamstrings`, `quadriceps`, `all`.
@@ -174,6 +175,9 @@ pub struct OutputSection {
     pub vtu: bool,
     /// Write an animated GLB.
     pub glb: bool,
+    /// Audit the tissue after every update into `audit.csv` (slow: about a second an
+    /// update).
+    pub audit: bool,
 }
 
 impl Default for OutputSection {
@@ -182,6 +186,7 @@ impl Default for OutputSection {
             frames: 25,
             vtu: true,
             glb: true,
+            audit: false,
         }
     }
 }

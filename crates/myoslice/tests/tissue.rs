@@ -7,28 +7,12 @@ mod common;
 use glam::{Quat, Vec3};
 use myoslice::muscle::MuscleCatalogue;
 use myoslice::prelude::*;
-use myoslice::tissue::{Tissue, TissueMetrics, bone_surfaces};
-
-/// A fresh tissue of a simulation (its own copy, to move by hand).
-fn tissue_of(sim: &Simulation) -> Tissue {
-    let lat = sim.lattice();
-    let meshes: Vec<_> = (0..lat.bones.len())
-        .map(|i| sim.skeleton().bone_trimesh(i).unwrap())
-        .collect();
-    Tissue::new(
-        lat,
-        sim.muscles(),
-        *sim.skeleton().knee(),
-        bone_surfaces(lat, &meshes),
-        Default::default(),
-    )
-    .unwrap()
-}
+use myoslice::tissue::TissueMetrics;
 
 #[test]
 fn rigid_motions_leave_no_deformation_and_no_area_change() {
     let sim = Simulation::phantom(SimulationConfig::default()).unwrap();
-    let mut t = tissue_of(&sim);
+    let mut t = common::tissue_of(&sim);
     let q = Quat::from_axis_angle(Vec3::new(0.2, 1.0, 0.4).normalize(), 0.9);
     let shift = Vec3::new(0.3, -0.1, 0.25);
     for (x, r) in t.fat.x.iter_mut().zip(&t.fat.rest) {
@@ -53,7 +37,7 @@ fn stretched_skin_shows_positive_area_change_and_compressed_skin_negative() {
     let sim = Simulation::phantom(SimulationConfig::default()).unwrap();
     let lat = sim.lattice();
     let fat = &lat.fat;
-    let mut t = tissue_of(&sim);
+    let mut t = common::tissue_of(&sim);
     // Around slice 40 the skin is pushed out (stretched); around slice 120, drawn in.
     for (band, factor) in [(38..43, 1.25f32), (118..123, 0.8f32)] {
         for s in band {
@@ -207,12 +191,12 @@ fn tissue_never_breaks_on(lattice: Lattice, speed: f64, folded: (usize, usize)) 
 
 #[test]
 fn fat_never_inverts_nor_self_intersects_through_a_deep_flexion() {
-    tissue_never_breaks_on(common::phantom_lattice().clone(), 1.0, (610, 10));
+    tissue_never_breaks_on(common::phantom_lattice().clone(), 1.0, (590, 2));
 }
 
 #[test]
 fn fat_never_inverts_nor_self_intersects_at_three_times_the_speed() {
-    tissue_never_breaks_on(common::phantom_lattice().clone(), 3.0, (610, 50));
+    tissue_never_breaks_on(common::phantom_lattice().clone(), 3.0, (590, 40));
 }
 
 /// The README's table of tissue rates offers a third of the default rate as a trade of
@@ -222,7 +206,7 @@ fn fat_never_inverts_nor_self_intersects_at_a_third_of_the_tissue_rate() {
     let mut cfg = SimulationConfig::default();
     cfg.tissue.rate_hz /= 3.0;
     let sim = Simulation::phantom(cfg).unwrap();
-    let max = tissue_never_breaks(sim, 1.0, (430, 10));
+    let max = tissue_never_breaks(sim, 1.0, (420, 2));
     // Updates 0.1 s apart fall at most at 123° of the flexion's 134°.
     assert!(
         max > 120.0,
@@ -235,7 +219,7 @@ fn visible_human_fat_never_inverts_nor_self_intersects_through_a_deep_flexion() 
     let Some(lattice) = common::vh_lattice() else {
         return;
     };
-    tissue_never_breaks_on(lattice.clone(), 1.0, (585, 15));
+    tissue_never_breaks_on(lattice.clone(), 1.0, (570, 8));
 }
 
 #[test]
@@ -243,7 +227,7 @@ fn visible_human_fat_never_inverts_nor_self_intersects_at_three_times_the_speed(
     let Some(lattice) = common::vh_lattice() else {
         return;
     };
-    tissue_never_breaks_on(lattice.clone(), 3.0, (585, 50));
+    tissue_never_breaks_on(lattice.clone(), 3.0, (570, 45));
 }
 
 /// After a deep flexion and back, with every muscle relaxed and the knee held straight
@@ -292,13 +276,13 @@ fn fat_after_flexion_and_rest(mut sim: Simulation) -> (f32, f32, f32, usize) {
     (anywhere, on_bone, muscles, folded)
 }
 
-/// The bounds of [`fat_after_flexion_and_rest`]: within 2 mm of rest on bone, elsewhere
-/// no further than the muscles it rides (which keep some of their shape), and no more
-/// than 4 elements still folded (4 and 3 measured).
+/// The bounds of [`fat_after_flexion_and_rest`]: within 0.5 mm of rest on bone, elsewhere
+/// no further than the muscles it rides (which keep some of their shape), and no element
+/// still folded.
 fn fat_comes_back_to_rest(sim: Simulation) {
     let (anywhere, on_bone, muscles, folded) = fat_after_flexion_and_rest(sim);
     assert!(
-        on_bone < 2e-3,
+        on_bone < 0.5e-3,
         "fat riding bone {:.2} mm from rest",
         on_bone * 1e3
     );
@@ -308,7 +292,7 @@ fn fat_comes_back_to_rest(sim: Simulation) {
         anywhere * 1e3,
         muscles * 1e3
     );
-    assert!(folded <= 4, "{folded} fat elements stay folded");
+    assert_eq!(folded, 0, "fat elements stay folded");
 }
 
 /// Fat sliding on bone comes back to its rest place once the knee is straight: it
@@ -541,7 +525,7 @@ fn every_muscle_lies_under_the_skin_at_rest() {
 #[test]
 fn a_muscle_moved_out_of_the_body_is_found_outside_the_skin() {
     let sim = Simulation::phantom(SimulationConfig::default()).unwrap();
-    let mut t = tissue_of(&sim);
+    let mut t = common::tissue_of(&sim);
     // Half a metre in front of the body: every vertex out, by at least 30 cm.
     let n = t.muscles[0].current.len();
     t.muscles[0]

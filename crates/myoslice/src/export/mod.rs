@@ -13,7 +13,7 @@ pub mod gltf;
 pub mod run;
 
 pub use gltf::{MorphMesh, RigidMesh, encode_glb};
-pub use run::{RunOutputs, RunSummary, RunWriter};
+pub use run::{RunAudit, RunOutputs, RunSummary, RunWriter};
 pub mod scenario_run;
 
 pub use scenario_run::{RunProgress, run_scenario, run_scenario_with};

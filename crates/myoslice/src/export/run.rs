@@ -14,7 +14,7 @@ use super::vtu::{write_atomic, write_pvd};
 use crate::body::{BodyId, body_of_bone};
 use crate::error::{Error, Result};
 use crate::simulation::Simulation;
-use crate::tissue::GuardTally;
+use crate::tissue::{GuardTally, TissueAudit};
 
 /// What to write.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -23,6 +23,9 @@ pub struct RunOutputs {
     pub vtu: bool,
     /// Animated GLB at the end.
     pub glb: bool,
+    /// Every soundness check of the tissue after each of its updates (`audit.csv`, and
+    /// the worst and last in the summary): slow, about a second an update.
+    pub audit: bool,
 }
 
 /// Extremes and totals of a run (`summary.json`).
@@ -56,7 +59,7 @@ pub struct RunSummary {
     /// How often the validity guard, the tissue's last resort, moved fat back toward
     /// the knee fold over the run (zeros without tissue).
     pub guard: GuardTally,
-    /// Wall time of the run (s).
+    /// Wall time of the run (s), an audit's left out.
     pub wall_time_s: f64,
     /// Simulated seconds per wall second.
     pub realtime_factor: f64,
@@ -70,6 +73,22 @@ pub struct RunSummary {
     /// What the model's build could not take from the catalogue
     /// ([`Simulation::warnings`]).
     pub warnings: Vec<String>,
+    /// The tissue audited after every update, when the run was asked to (None otherwise,
+    /// or without tissue).
+    pub audit: Option<RunAudit>,
+}
+
+/// A run's tissue, audited after every update ([`Simulation::audit`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RunAudit {
+    /// Tissue updates audited.
+    pub updates: u64,
+    /// The worst of each check over them.
+    pub worst: TissueAudit,
+    /// The last update's (after the run: whether the tissue came back).
+    pub last: TissueAudit,
+    /// Wall time the audits took (s), left out of the run's wall time.
+    pub wall_time_s: f64,
 }
 
 /// An open run folder.
@@ -78,6 +97,8 @@ pub struct RunWriter {
     dir: PathBuf,
     outputs: RunOutputs,
     csv: std::io::BufWriter<std::fs::File>,
+    /// `audit.csv`, when auditing, and the tissue update audited last.
+    audit_csv: Option<(std::io::BufWriter<std::fs::File>, u64)>,
     pvd: Vec<(f64, String)>,
     glb_times: Vec<f32>,
     skin_frames: Vec<Vec<Vec3>>,
@@ -104,10 +125,24 @@ impl RunWriter {
             header += &format!(",{n}_excitation,{n}_activation,{n}_force_n");
         }
         writeln!(csv, "{header}").map_err(|e| werr(&csv_path, e))?;
+        let audit_csv = match (outputs.audit, sim.tissue()) {
+            (true, Some(t)) => {
+                let p = dir.join("audit.csv");
+                let f = std::fs::File::create(&p).map_err(|e| werr(&p, e))?;
+                let mut f = std::io::BufWriter::new(f);
+                let head = TissueAudit::CSV_HEADER;
+                writeln!(f, "time_s,knee_angle_deg,tissue_update,{head}")
+                    .map_err(|e| werr(&p, e))?;
+                // The tissue as built is audited as update 0.
+                Some((f, t.updates().wrapping_sub(1)))
+            }
+            _ => None,
+        };
         let mut w = Self {
             dir: dir.to_path_buf(),
             outputs,
             csv,
+            audit_csv,
             pvd: Vec::new(),
             glb_times: Vec::new(),
             skin_frames: Vec::new(),
@@ -131,8 +166,10 @@ impl RunWriter {
                 muscles_wall_time_s: 0.0,
                 tissue_wall_time_s: 0.0,
                 warnings: sim.warnings().to_vec(),
+                audit: None,
             },
         };
+        w.audit(sim)?;
         w.row(sim)?;
         w.frame(sim)?;
         Ok(w)
@@ -158,6 +195,47 @@ impl RunWriter {
         s.max_knee_speed_deg_s = s.max_knee_speed_deg_s.max(v.abs());
         s.final_knee_angle_deg = a;
         s.duration_s = sim.time();
+        Ok(())
+    }
+
+    /// Audits the tissue if the run asked for it and it has updated since the last audit:
+    /// one row of `audit.csv`, and the summary's worst and last. Call after every step.
+    pub fn audit(&mut self, sim: &Simulation) -> Result<()> {
+        let (Some((csv, seen)), Some(t)) = (self.audit_csv.as_mut(), sim.tissue()) else {
+            return Ok(());
+        };
+        if t.updates() == *seen {
+            return Ok(());
+        }
+        *seen = t.updates();
+        let start = web_time::Instant::now();
+        let a = t.audit(sim.frames());
+        let line = format!(
+            "{:.6},{:.6},{},{}",
+            sim.time(),
+            sim.knee_angle().to_degrees(),
+            t.updates(),
+            a.csv_row()
+        );
+        let p = self.dir.join("audit.csv");
+        writeln!(csv, "{line}").map_err(|e| werr(&p, e))?;
+        csv.flush().map_err(|e| werr(&p, e))?;
+        let took = start.elapsed().as_secs_f64();
+        let s = &mut self.summary.audit;
+        *s = Some(match s.take() {
+            Some(r) => RunAudit {
+                updates: r.updates + 1,
+                worst: r.worst.worse(&a),
+                last: a,
+                wall_time_s: r.wall_time_s + took,
+            },
+            None => RunAudit {
+                updates: 1,
+                worst: a,
+                last: a,
+                wall_time_s: took,
+            },
+        });
         Ok(())
     }
 
@@ -219,8 +297,10 @@ impl RunWriter {
         Ok(())
     }
 
-    /// Writes the GLB and the summary; returns the summary.
+    /// Writes the GLB and the summary; returns the summary. `wall_s` is the run's wall time,
+    /// its audits included: the summary leaves them out.
     pub fn finish(mut self, sim: &Simulation, wall_s: f64) -> Result<RunSummary> {
+        let wall_s = wall_s - self.summary.audit.map_or(0.0, |a| a.wall_time_s);
         self.summary.steps = sim.steps();
         self.summary.duration_s = sim.time();
         self.summary.wall_time_s = wall_s;

@@ -53,6 +53,7 @@ pub fn run_scenario_with(
     let outputs = RunOutputs {
         vtu: scenario.output.vtu,
         glb: scenario.output.glb,
+        audit: scenario.output.audit,
     };
     let mut w = RunWriter::create(out, &sim, outputs)?;
     let dt = scenario.simulation.step_s;
@@ -63,11 +64,13 @@ pub fn run_scenario_with(
     let mut next_frame = 1;
     for k in 1..=steps {
         sim.step(dt)?;
+        w.audit(&sim)?;
         if k % row_every == 0 || k == steps {
             w.row(&sim)?;
         }
         if k * frames >= next_frame * steps {
             sim.update_tissue()?;
+            w.audit(&sim)?;
             w.frame(&sim)?;
             next_frame += 1;
         }

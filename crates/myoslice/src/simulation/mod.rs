@@ -26,7 +26,7 @@ use crate::lattice::Lattice;
 use crate::muscle::{
     Axis, BodyFrames, ChainLoad, ChainOptions, MuscleCatalogue, MuscleGroup, MuscleUnit,
 };
-use crate::tissue::{BoneOverlap, SkinBreach, Tissue, TissueMetrics, bone_surfaces};
+use crate::tissue::{BoneOverlap, SkinBreach, Tissue, TissueAudit, TissueMetrics, bone_surfaces};
 
 /// Simulated time (s) the muscle chains settle at rest before time 0 (see `settle`).
 const SETTLE_S: f64 = 2.0;
@@ -323,6 +323,14 @@ impl Simulation {
         self.tissue
             .as_ref()
             .and_then(|t| t.bones_outside_skin(&self.frames))
+    }
+
+    /// Every soundness check of the tissue now ([`Tissue::audit`]): folded and squashed
+    /// fat, muscles and bones out through the skin, muscles in bone and in one another,
+    /// skin crossings. Exact, about a second on a whole leg: for checks, not every frame.
+    /// None when tissue is disabled.
+    pub fn audit(&self) -> Option<TissueAudit> {
+        self.tissue.as_ref().map(|t| t.audit(&self.frames))
     }
 
     /// Wall-clock time spent in `step` since the build or `reset_timers`.

@@ -6,13 +6,36 @@ use glam::Vec3;
 use super::bone_keep_out::Bones;
 use crate::lattice::winding_number;
 
-/// How far muscle surfaces reach into bone (see [`super::Tissue::muscles_in_bone`]).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct BoneOverlap {
-    /// Muscle vertices more than 1 mm inside a bone.
+/// How far muscle surfaces reach into something they should not: a bone
+/// ([`BoneOverlap`], see [`super::Tissue::muscles_in_bone`]) or another muscle
+/// ([`super::MuscleOverlap`], see [`super::Tissue::muscles_in_muscles`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct Overlap {
+    /// Muscle vertices more than 1 mm inside.
     pub vertices_over_1mm: usize,
-    /// Deepest muscle vertex inside a bone (m), 0 when none is.
+    /// Deepest muscle vertex inside (m), 0 when none is.
     pub deepest_m: f32,
+}
+
+/// How far muscle surfaces reach into bone.
+pub type BoneOverlap = Overlap;
+
+impl Overlap {
+    /// The worse of two, count and depth each (a run's worst moment).
+    pub fn worse(&self, o: &Self) -> Self {
+        Self {
+            vertices_over_1mm: self.vertices_over_1mm.max(o.vertices_over_1mm),
+            deepest_m: self.deepest_m.max(o.deepest_m),
+        }
+    }
+
+    /// Of several muscles together: their counts summed, the deepest of them.
+    pub fn total(parts: &[Self]) -> Self {
+        Self {
+            vertices_over_1mm: parts.iter().map(|o| o.vertices_over_1mm).sum(),
+            deepest_m: parts.iter().map(|o| o.deepest_m).fold(0.0, f32::max),
+        }
+    }
 }
 
 /// Measures `vertices` against every bone: a point its distance field calls more than

@@ -99,14 +99,21 @@ impl Rigid {
 }
 
 impl Tissue {
-    /// Keeps thigh-side and calf-side fat apart behind the knee ([`Contact`]), and pulls
+    /// Keeps thigh-side and calf-side fat apart behind the knee ([`Contact`]) by a gap
+    /// that opens as the knee bends (`opened`, 0 straight to 1), and pulls
     /// the skin there back toward the plane by the shares `limits` give (see
     /// [`skin_limits`]; spared at the crease's apex, see [`APEX_M`]).
-    pub(super) fn apply_contact(&mut self, c: &Contact, gap: f32, limits: &[(f32, f32)]) {
+    pub(super) fn apply_contact(
+        &mut self,
+        c: &Contact,
+        gap: f32,
+        limits: &[(f32, f32)],
+        opened: f32,
+    ) {
         let l1 = self.layers + 1;
         let fixed = &self.fixed;
         let x = &mut self.fat.x;
-        for &v in &fixed.posterior {
+        for (&v, &rest_side) in fixed.posterior.iter().zip(&fixed.posterior_rest_side) {
             let v = v as usize;
             // Vertices outside the relaxed region sit on the fold (to within 0.1 mm), which
             // keeps its side.
@@ -114,9 +121,16 @@ impl Tissue {
                 continue;
             }
             // Deeper layers stop further from the contact, so squeezed elements stay
-            // thin but never flat.
+            // thin but never flat. The gap opens as the knee bends (`opened` from 0 to 1):
+            // straight, no vertex is pushed further off than it lies at rest, where the
+            // pushes had folded the thin elements across the plane.
             let depth = (self.layers - v % l1) as f32;
-            x[v] = c.apply(x[v], fixed.thigh_side[v], gap + LAYER_GAP * depth);
+            let margin = gap + LAYER_GAP * depth;
+            x[v] = c.apply(
+                x[v],
+                fixed.thigh_side[v],
+                margin.min(rest_side + margin * opened),
+            );
         }
         // Only pulls toward the plane, to no less than `gap` from it: the push above
         // holds the other bound.

@@ -16,14 +16,14 @@ const FASCIA_DRAG: f32 = 0.2;
 const PULL_ACROSS: f32 = 0.7;
 const PULL_ALONG: f32 = 0.15;
 
-/// Where each inner fat vertex facing a muscle (`muscle_ref`: fat vertex → muscle and
-/// its vertex) goes this update, with the direction across its fat layer, into `out`.
+/// Where each inner fat vertex facing a muscle (`muscle_ref`: fat vertex → muscle, its
+/// vertex and the rest offset from the surface under it) goes this update, with the direction across its fat layer, into `out`.
 /// `safe` is the knee fold of the rest shape and `weights` the fold's weight of each
 /// vertex; `thigh_turn`, `axis` and `theta` the thigh's rotation, the knee axis and angle.
 /// The vertex keeps its rest offset from its muscle vertex turned as the tissue about it
 /// turns (the paper's moving vector alone would shear thin fat at large angles).
 pub(super) fn targets(
-    muscle_ref: &[Option<(u32, u32)>],
+    muscle_ref: &[Option<(u32, u32, Vec3)>],
     muscles: &[MuscleShape],
     fat_rest: &[Vec3],
     (safe, weights): (&[Vec3], &[f32]),
@@ -33,7 +33,7 @@ pub(super) fn targets(
 ) {
     out.clear();
     out.par_extend(muscle_ref.par_iter().enumerate().filter_map(|(v, r)| {
-        let (m, mv) = (*r)?;
+        let (m, mv, under_offset) = (*r)?;
         let shape = &muscles[m as usize];
         let turn = thigh_turn * Quat::from_axis_angle(axis, theta * weights[v]);
         let offset = fat_rest[v] - shape.rest[mv as usize];
@@ -49,10 +49,12 @@ pub(super) fn targets(
         // Across it, the fat keeps its rest offset from the muscle's surface where the fat
         // now lies over it, not from the vertex it lay over at rest: a muscle that slides
         // far under the fat (a gastrocnemius as the knee bends) would otherwise carry the
-        // fat over its own tapering ends, and through neighbouring tissue.
+        // fat over its own tapering ends, and through neighbouring tissue. The offset is
+        // from the surface under the fat at rest (not from that vertex), so that a tissue
+        // at rest stays there.
         let across = shape
             .surface_under(mv, base + along)
-            .map_or(across, |q| n * (q + turn * offset - base).dot(n));
+            .map_or(across, |q| n * (q + turn * under_offset - base).dot(n));
         Some((v as u32, base + across + along, n))
     }));
 }

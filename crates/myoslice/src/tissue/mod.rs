@@ -2,6 +2,7 @@
 //! that follows muscles and bones, the knee fold and contact plane behind the knee, a
 //! validity guard, and the per-element metrics of the paper (section 5.3).
 
+mod audit;
 mod bone_keep_out;
 mod bone_overlap;
 mod bone_slide;
@@ -17,6 +18,7 @@ mod incidence;
 pub mod intersect;
 pub mod knee_fold;
 pub mod metrics;
+mod muscle_overlap;
 mod muscle_placing;
 pub mod muscle_shape;
 mod phases;
@@ -36,11 +38,13 @@ use crate::par::*;
 use glam::{Quat, Vec3};
 use parry3d::shape::TriMesh;
 
+pub use audit::TissueAudit;
 pub use fat_solver::FatSolver;
 pub use guard_tally::GuardTally;
 pub use knee_fold::{Contact, FoldZone, KneeFold};
 use metrics::LazyMetrics;
 pub use metrics::TissueMetrics;
+pub use muscle_overlap::MuscleOverlap;
 use muscle_placing::Placing;
 pub use muscle_shape::MuscleShape;
 use phases::Lap;
@@ -55,13 +59,17 @@ use crate::error::Result;
 use crate::geometry::BoneSdf;
 use crate::lattice::{InnerContact, Lattice};
 use crate::muscle::{BodyFrames, MuscleUnit};
-pub use bone_overlap::BoneOverlap;
+pub use bone_overlap::{BoneOverlap, Overlap};
 use bone_slide::{BoneMesh, BoneSlide};
 use fat_keep_out::FatKeepOut;
 use guard::Guard;
 
 /// Extra distance (m) from the contact plane per fat layer below the skin.
 const LAYER_GAP: f32 = 0.001;
+
+/// Knee angle (rad) by which the contact behind the knee keeps its full gap; at rest it
+/// keeps each vertex at no more than its rest distance from the plane.
+const CONTACT_OPENS_RAD: f32 = std::f32::consts::PI / 6.0;
 
 /// Body-surface triangles behind the knee and within this distance (m) of it at rest are
 /// guarded against crossing; farther out the tissue moves nearly rigidly with its bone.
@@ -89,12 +97,16 @@ pub type BoneSurfaces = Arc<Vec<(BodyId, TriMesh)>>;
 /// What a tissue update needs that never changes: built once from the lattice.
 #[derive(Debug)]
 struct TissueStatic {
-    /// Fat vertex → (muscle, muscle vertex) it follows.
-    muscle_ref: Vec<Option<(u32, u32)>>,
+    /// Fat vertex → (muscle, muscle vertex) it follows, and its rest offset from the
+    /// muscle's surface under it ([`MuscleShape::surface_under`] at rest).
+    muscle_ref: Vec<Option<(u32, u32, Vec3)>>,
     /// Whether a fat vertex belongs to the thigh side of the knee.
     thigh_side: Vec<bool>,
     /// Fat vertices behind the knee axis at rest (the contact acts there).
     posterior: Vec<u32>,
+    /// How far each of [`Self::posterior`] lies from the contact plane at rest, on its
+    /// own side (m): the contact keeps no vertex further off than that at rest.
+    posterior_rest_side: Vec<f32>,
     /// The skin's among them, the whole length of the lattice: drawn back toward the
     /// contact plane wherever it lies further from it than its bone alone would carry it
     /// (see [`crease`]), which happens mostly near the knee, where the fold moves it.
@@ -177,6 +189,8 @@ pub struct Tissue {
     metrics: LazyMetrics,
     /// The guard's interventions so far.
     guard_tally: GuardTally,
+    /// Updates done since the tissue was built.
+    updates: u64,
     /// Time accumulated since the last update (s).
     pub(crate) pending: f64,
     /// How long each phase of the last update took.
@@ -226,7 +240,12 @@ impl Tissue {
                         if let Some(si) =
                             muscles.iter().position(|m| m.lattice_index == mi as usize)
                         {
-                            muscle_ref[v as usize] = Some((si as u32, mv));
+                            let shape = &shapes[si];
+                            let p = fat.vertices[v as usize];
+                            let under = shape
+                                .surface_under(mv, p)
+                                .unwrap_or(shape.rest[mv as usize]);
+                            muscle_ref[v as usize] = Some((si as u32, mv, p - under));
                         }
                     }
                 }
@@ -274,7 +293,15 @@ impl Tissue {
             &bone_sdfs,
             &bones,
         );
+        let posterior_rest_side = posterior
+            .iter()
+            .map(|&v| {
+                let p = fat.vertices[v as usize];
+                rest_contact.locate(p, p.z >= kz).1.max(0.0)
+            })
+            .collect();
         let fixed = TissueStatic {
+            posterior_rest_side,
             muscle_ref,
             posterior_skin_rest: posterior_skin
                 .iter()
@@ -308,6 +335,7 @@ impl Tissue {
             layers: fat.layers,
             metrics: LazyMetrics::built(),
             guard_tally: GuardTally::default(),
+            updates: 0,
             pending: 0.0,
             last_phases: TissuePhases::default(),
             placed: None,
@@ -325,6 +353,12 @@ impl Tissue {
     /// How often the validity guard stepped in since the tissue was built.
     pub fn guard_tally(&self) -> GuardTally {
         self.guard_tally
+    }
+
+    /// Updates done since the tissue was built (a checkpoint carries its count): a run
+    /// that checks the tissue after every update watches it change.
+    pub fn updates(&self) -> u64 {
+        self.updates
     }
 
     /// The options.
@@ -491,12 +525,15 @@ impl Tissue {
         }
         let (targets, limits) = (&sc.muscle_targets, &sc.skin_limits);
         fat_on_muscle::pull(&mut self.fat.x, targets);
-        self.apply_contact(&contact, gap, limits);
+        // The contact's gap opens as the knee bends: at rest the fat across the plane
+        // is whole.
+        let opened = (theta / CONTACT_OPENS_RAD).clamp(0.0, 1.0);
+        self.apply_contact(&contact, gap, limits, opened);
         let k = self.config.stiffness as f32;
         for _ in 0..self.config.iterations {
             self.fat.iterate(k);
             fat_on_muscle::pull(&mut self.fat.x, targets);
-            self.apply_contact(&contact, gap, limits);
+            self.apply_contact(&contact, gap, limits, opened);
         }
         phases.shape_matching_s = lap.lap();
         let pose = |b: BodyId| match b {
@@ -518,7 +555,7 @@ impl Tissue {
             &fixed.bones,
             pose,
         );
-        self.apply_contact(&contact, gap, &sc.skin_limits);
+        self.apply_contact(&contact, gap, &sc.skin_limits, opened);
         self.theta = theta;
         self.scratch = sc;
         phases.bone_sliding_s = lap.lap();

@@ -276,7 +276,12 @@ impl MuscleShape {
         // vertex: the same operations on the same values, so the same bits).
         let root: Vec<f32> = rings.iter().map(|r| r.3.sqrt()).collect();
         let mut across = vec![0.0f32; rings.len()];
-        for pass in 0..VOLUME_PASSES {
+        // The closest volume found, and the cross-section scale that gave it: where the
+        // contact plane flattens a muscle its volume need not grow with the scale, and
+        // the passes can swing ever wider (the plantaris by the condyle went to ×20).
+        let mut best = (f64::INFINITY, across_fix);
+        let mut pass = 0;
+        loop {
             for (a, r) in across.iter_mut().zip(&root) {
                 *a = across_fix / r;
             }
@@ -304,13 +309,29 @@ impl MuscleShape {
                 }
             }
             // What the piecewise map still gains or loses, the cross-sections give back:
-            // one factor per muscle, the square root of the volume ratio.
+            // one factor per muscle, the square root of the volume ratio, at most a
+            // quarter either way a pass.
             let v = volume_about(&self.current, &self.triangles, origin);
             self.volume_now = v;
-            let Some(fix) = volume_fix(self.rest_volume, v, pass) else {
+            let miss = (v / self.rest_volume - 1.0).abs();
+            if miss < best.0 {
+                best = (miss, across_fix);
+            }
+            if pass == VOLUME_PASSES {
                 break;
-            };
-            across_fix *= fix;
+            }
+            match volume_fix(self.rest_volume, v, pass) {
+                Some(fix) => across_fix *= fix.clamp(0.8, 1.25),
+                // Done; or out of passes, or no volume at all: then the best scale again
+                // (one more placement), unless this was it.
+                None if best.1 == across_fix => break,
+                None => {
+                    across_fix = best.1;
+                    pass = VOLUME_PASSES;
+                    continue;
+                }
+            }
+            pass += 1;
         }
     }
 

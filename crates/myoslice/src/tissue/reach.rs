@@ -1,10 +1,11 @@
-//! How far muscles and bones reach where they should not: muscles into bone, muscles and
-//! bones out through the skin. Exact, for checks and tests, not for every update.
+//! How far muscles and bones reach where they should not: muscles into bone and into one
+//! another, muscles and bones out through the skin. Exact, for checks and tests, not for every update.
 
 use crate::par::*;
 use glam::Vec3;
 
 use super::bone_keep_out::Bones;
+use super::muscle_overlap::{MuscleOverlap, muscle_overlaps};
 use super::{BoneOverlap, SkinBreach, Tissue, bone_overlap};
 use crate::muscle::BodyFrames;
 
@@ -55,5 +56,19 @@ impl Tissue {
             .collect();
         let bones: Vec<&[Vec3]> = bones.iter().map(Vec::as_slice).collect();
         self.fixed.skin.breaches(&self.fat.x, &bones)
+    }
+}
+
+impl Tissue {
+    /// How far each muscle's surface reaches into the other muscles now, in muscle order
+    /// (exact: a tree query per muscle vertex within another muscle's box, the winding
+    /// number to confirm; for checks, not for every update).
+    pub fn muscles_in_muscles(&self) -> Vec<MuscleOverlap> {
+        let surfaces: Vec<(&[Vec3], &[[u32; 3]])> = self
+            .muscles
+            .iter()
+            .map(|m| (m.current.as_slice(), m.triangles.as_slice()))
+            .collect();
+        muscle_overlaps(&surfaces)
     }
 }

@@ -10,7 +10,7 @@ use crate::lattice::{FatLattice, oriented_trimesh};
 
 /// How far a muscle's surface reaches out through the skin (see
 /// [`super::Tissue::muscles_outside_skin`]).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
 pub struct SkinBreach {
     /// Muscle vertices more than 1 mm outside the skin.
     pub vertices_over_1mm: usize,
@@ -29,6 +29,8 @@ pub(crate) struct ClosedSkin {
     triangles: Vec<[u32; 3]>,
     /// Positions in `used` of the outer ring of the first and last slice.
     ends: [Vec<u32>; 2],
+    /// How many of `triangles` are the skin's (the end fans follow them).
+    sides: usize,
 }
 
 impl ClosedSkin {
@@ -54,6 +56,7 @@ impl ClosedSkin {
         let ends: [Vec<u32>; 2] =
             [ring(0), ring(fat.slices - 1)].map(|r| r.into_iter().map(&mut index).collect());
         let n = used.len() as u32;
+        let sides = triangles.len();
         // Each end fan faces away from the other end (the ends never swap places, so the
         // rest shape settles it for good).
         let centres = ends.each_ref().map(|r| {
@@ -79,7 +82,15 @@ impl ClosedSkin {
             used,
             triangles,
             ends,
+            sides,
         }
+    }
+
+    /// Pairs of skin triangles (sharing no vertex) that cross, with the fat vertices at
+    /// `fat_x`: the skin passing through itself.
+    pub(crate) fn crossings(&self, fat_x: &[Vec3]) -> usize {
+        let v: Vec<Vec3> = self.used.iter().map(|&i| fat_x[i as usize]).collect();
+        crate::tissue::intersect::self_intersections(&v, &self.triangles[..self.sides])
     }
 
     /// How far each of `muscles` (vertex lists) reaches out through the skin with the fat

@@ -17,6 +17,7 @@ pub(crate) struct TissueBackup {
     theta: f32,
     metrics: LazyMetrics,
     guard_tally: GuardTally,
+    updates: u64,
     /// Each muscle's vertices, volume and keep-out memory.
     muscles: Vec<(Vec<Vec3>, f64, KeepOutMemory)>,
 }
@@ -34,6 +35,7 @@ impl Tissue {
             theta: self.theta,
             metrics: self.metrics.clone(),
             guard_tally: self.guard_tally,
+            updates: self.updates,
             muscles: self
                 .muscles
                 .iter()
@@ -47,7 +49,7 @@ impl Tissue {
         (self.fat.x, self.fat.rot) = (b.fat_x, b.fat_rot);
         (self.fat.free, self.fat.active) = (b.fat_free, b.fat_active);
         (self.drift, self.theta, self.metrics) = (b.drift, b.theta, b.metrics);
-        self.guard_tally = b.guard_tally;
+        (self.guard_tally, self.updates) = (b.guard_tally, b.updates);
         // Shapes placed ahead for an update that will not come now.
         self.placed = None;
         for (shape, (c, v, keep)) in self.muscles.iter_mut().zip(b.muscles) {

@@ -84,6 +84,7 @@ impl Tissue {
         self.scratch = sc;
         self.metrics = LazyMetrics::updated(guarded);
         self.guard_tally.add(guarded);
+        self.updates += 1;
         phases.guard_s = lap.lap();
         self.last_phases = phases;
     }

@@ -271,3 +271,19 @@ pub fn muscles_in_bone_beyond(
         .fold(0.0, f32::max);
     (count.saturating_sub(at_rest), deepest)
 }
+
+/// A fresh tissue of a simulation (its own copy, to move by hand).
+pub fn tissue_of(sim: &Simulation) -> myoslice::tissue::Tissue {
+    let lat = sim.lattice();
+    let meshes: Vec<_> = (0..lat.bones.len())
+        .map(|i| sim.skeleton().bone_trimesh(i).unwrap())
+        .collect();
+    myoslice::tissue::Tissue::new(
+        lat,
+        sim.muscles(),
+        *sim.skeleton().knee(),
+        myoslice::tissue::bone_surfaces(lat, &meshes),
+        Default::default(),
+    )
+    .unwrap()
+}

@@ -1,0 +1,186 @@
+//! Every check of the tissue's soundness at one moment, measured the way a user's tools
+//! do: a hexahedron is valid when all eight corner Jacobians are positive (ParaView's
+//! test), a point is inside a closed surface by its winding number. Exact, tens to
+//! hundreds of milliseconds: for checks after an update, not inside one.
+
+use serde::Serialize;
+
+use super::{BoneOverlap, MuscleOverlap, Overlap, SkinBreach, Tissue};
+use crate::body::BodyId;
+use crate::lattice::{hex_is_valid, hex_volume_f32};
+use crate::muscle::BodyFrames;
+use crate::par::*;
+
+/// The tissue's soundness now (see [`Tissue::audit`]). Counts are summed over muscles
+/// and bones, depths are the largest.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TissueAudit {
+    /// Fat hexahedra with a corner Jacobian at or below zero.
+    pub folded_fat: usize,
+    /// Fat hexahedra below half their rest volume (fat is nearly incompressible: it should
+    /// bulge, not vanish).
+    pub fat_under_half_volume: usize,
+    /// Smallest fat element volume over its rest volume.
+    pub min_fat_volume_ratio: f32,
+    /// Muscle vertices outside the skin (None when the skin cannot be closed into a mesh).
+    pub muscles_out_of_skin: Option<SkinBreach>,
+    /// Bone vertices outside the skin (None when the skin cannot be closed into a mesh).
+    pub bones_out_of_skin: Option<SkinBreach>,
+    /// Muscle vertices inside bone.
+    pub muscles_in_bone: BoneOverlap,
+    /// Muscle vertices inside another muscle.
+    pub muscles_in_muscles: MuscleOverlap,
+    /// Pairs of skin triangles that cross.
+    pub skin_crossings: usize,
+    /// Smallest and largest muscle volume over its rest volume.
+    pub muscle_volume_ratio: [f32; 2],
+    /// Farthest fat vertex from its rest place carried by its bone (m): with the knee
+    /// straight again, how far the fat is from coming back.
+    pub fat_off_rest_m: f32,
+    /// Whether every fat and muscle vertex is finite.
+    pub finite: bool,
+}
+
+fn worse_breach(a: Option<SkinBreach>, b: Option<SkinBreach>) -> Option<SkinBreach> {
+    match (a, b) {
+        (Some(a), Some(b)) => Some(SkinBreach {
+            vertices_over_1mm: a.vertices_over_1mm.max(b.vertices_over_1mm),
+            farthest_m: a.farthest_m.max(b.farthest_m),
+        }),
+        _ => None,
+    }
+}
+
+fn sum_breach(b: Option<Vec<SkinBreach>>) -> Option<SkinBreach> {
+    b.map(|v| SkinBreach {
+        vertices_over_1mm: v.iter().map(|b| b.vertices_over_1mm).sum(),
+        farthest_m: v.iter().map(|b| b.farthest_m).fold(0.0, f32::max),
+    })
+}
+
+impl TissueAudit {
+    /// The worse of two audits, field by field: over a run, its worst moment for each
+    /// check (a skin that could not be closed once stays unmeasured).
+    ///
+    /// ```
+    /// use myoslice::prelude::*;
+    /// let mut sim = Simulation::phantom(SimulationConfig::default())?;
+    /// let rest = sim.audit().expect("the phantom has tissue");
+    /// sim.set_excitation("semitendinosus", 1.0)?;
+    /// sim.step(0.1)?;
+    /// let worst = rest.worse(&sim.audit().expect("tissue"));
+    /// assert!(worst.folded_fat >= rest.folded_fat);
+    /// # Ok::<(), myoslice::Error>(())
+    /// ```
+    pub fn worse(&self, o: &Self) -> Self {
+        Self {
+            folded_fat: self.folded_fat.max(o.folded_fat),
+            fat_under_half_volume: self.fat_under_half_volume.max(o.fat_under_half_volume),
+            min_fat_volume_ratio: self.min_fat_volume_ratio.min(o.min_fat_volume_ratio),
+            muscles_out_of_skin: worse_breach(self.muscles_out_of_skin, o.muscles_out_of_skin),
+            bones_out_of_skin: worse_breach(self.bones_out_of_skin, o.bones_out_of_skin),
+            muscles_in_bone: self.muscles_in_bone.worse(&o.muscles_in_bone),
+            muscles_in_muscles: self.muscles_in_muscles.worse(&o.muscles_in_muscles),
+            skin_crossings: self.skin_crossings.max(o.skin_crossings),
+            muscle_volume_ratio: [
+                self.muscle_volume_ratio[0].min(o.muscle_volume_ratio[0]),
+                self.muscle_volume_ratio[1].max(o.muscle_volume_ratio[1]),
+            ],
+            fat_off_rest_m: self.fat_off_rest_m.max(o.fat_off_rest_m),
+            finite: self.finite && o.finite,
+        }
+    }
+
+    /// The column names of [`Self::csv_row`] (lengths in mm).
+    pub const CSV_HEADER: &'static str = "folded_fat,fat_under_half_volume,min_fat_volume_ratio,\
+muscle_vertices_out_of_skin,muscle_out_of_skin_mm,bone_vertices_out_of_skin,bone_out_of_skin_mm,\
+muscle_vertices_in_bone,muscle_in_bone_mm,muscle_vertices_in_muscle,muscle_in_muscle_mm,\
+skin_crossings,min_muscle_volume_ratio,max_muscle_volume_ratio,fat_off_rest_mm,finite";
+
+    /// The audit as one CSV row (an empty cell where the skin could not be closed).
+    pub fn csv_row(&self) -> String {
+        let breach = |b: Option<SkinBreach>| {
+            b.map_or_else(
+                || ",".to_string(),
+                |b| format!("{},{:.3}", b.vertices_over_1mm, b.farthest_m * 1e3),
+            )
+        };
+        format!(
+            "{},{},{:.5},{},{},{},{:.3},{},{:.3},{},{:.5},{:.5},{:.3},{}",
+            self.folded_fat,
+            self.fat_under_half_volume,
+            self.min_fat_volume_ratio,
+            breach(self.muscles_out_of_skin),
+            breach(self.bones_out_of_skin),
+            self.muscles_in_bone.vertices_over_1mm,
+            self.muscles_in_bone.deepest_m * 1e3,
+            self.muscles_in_muscles.vertices_over_1mm,
+            self.muscles_in_muscles.deepest_m * 1e3,
+            self.skin_crossings,
+            self.muscle_volume_ratio[0],
+            self.muscle_volume_ratio[1],
+            self.fat_off_rest_m * 1e3,
+            self.finite,
+        )
+    }
+}
+
+impl Tissue {
+    /// Every soundness check of the tissue now, with the bones at `frames`: folded and
+    /// squashed fat, muscles and bones out through the skin, muscles in bone and in one
+    /// another, the skin crossing itself, muscle volumes, and how far the fat is from its
+    /// rest place. Exact (see the module); a second or so on a whole leg.
+    pub fn audit(&self, frames: &BodyFrames) -> TissueAudit {
+        let fat = &self.fat;
+        let (folded_fat, under_half, min_ratio) = fat
+            .hexes
+            .par_iter()
+            .zip(&fat.rest_volume)
+            .map(|(h, &v0)| {
+                let r = (f64::from(hex_volume_f32(&fat.x, h)) / v0) as f32;
+                (
+                    usize::from(!hex_is_valid(&fat.x, h)),
+                    usize::from(r < 0.5),
+                    r,
+                )
+            })
+            .reduce(
+                || (0, 0, f32::INFINITY),
+                |a, b| (a.0 + b.0, a.1 + b.1, a.2.min(b.2)),
+            );
+        let fat_off_rest_m = fat
+            .x
+            .par_iter()
+            .zip(&fat.rest)
+            .zip(&self.fixed.thigh_side)
+            .map(|((x, r), &thigh)| {
+                let body = if thigh { BodyId::Thigh } else { BodyId::Shank };
+                x.distance(frames.point(body, *r))
+            })
+            .reduce(|| 0.0, f32::max);
+        let muscle_volume_ratio = self
+            .muscles
+            .iter()
+            .map(|m| (m.volume_now / m.rest_volume.max(1e-12)) as f32)
+            .fold([f32::INFINITY, f32::NEG_INFINITY], |[lo, hi], r| {
+                [lo.min(r), hi.max(r)]
+            });
+        TissueAudit {
+            folded_fat,
+            fat_under_half_volume: under_half,
+            min_fat_volume_ratio: min_ratio,
+            muscles_out_of_skin: sum_breach(self.muscles_outside_skin()),
+            bones_out_of_skin: sum_breach(self.bones_outside_skin(frames)),
+            muscles_in_bone: Overlap::total(&self.muscles_in_bone(frames)),
+            muscles_in_muscles: Overlap::total(&self.muscles_in_muscles()),
+            skin_crossings: self.fixed.skin.crossings(&fat.x),
+            muscle_volume_ratio,
+            fat_off_rest_m,
+            finite: fat.x.iter().all(|p| p.is_finite())
+                && self
+                    .muscles
+                    .iter()
+                    .all(|m| m.current.iter().all(|p| p.is_finite())),
+        }
+    }
+}
