@@ -17,6 +17,8 @@ pub mod app;
 #[cfg(feature = "window")]
 pub mod frame_stats;
 #[cfg(feature = "window")]
+pub mod readouts;
+#[cfg(feature = "window")]
 pub mod touch;
 #[cfg(feature = "window")]
 pub mod ui;

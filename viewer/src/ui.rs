@@ -111,6 +111,8 @@ pub struct UiState {
     pub source: ModelSource,
     /// Where the panel was drawn last (points): a finger put down there is the panel's.
     pub panel_rect: Option<egui::Rect>,
+    /// The tissue audit last asked for.
+    pub audit: crate::readouts::AuditReadout,
 }
 
 impl Default for UiState {
@@ -135,6 +137,7 @@ impl Default for UiState {
             open_unmapped: Unmapped::Error,
             source: ModelSource::Phantom,
             panel_rect: None,
+            audit: Default::default(),
         }
     }
 }
@@ -262,73 +265,6 @@ impl UiState {
             self.error = None;
         }
         actions
-    }
-
-    fn readouts(&self, ui: &mut egui::Ui, sim: &Simulation) {
-        let lat = sim.lattice();
-        egui::Grid::new("readouts").num_columns(2).show(ui, |ui| {
-            ui.label("time");
-            ui.label(format!("{:.3} s", sim.time()));
-            ui.end_row();
-            ui.label("knee angle");
-            ui.label(format!(
-                "{:.1}°  ({:+.0}°/s)",
-                sim.knee_angle().to_degrees(),
-                sim.knee_velocity().to_degrees()
-            ));
-            ui.end_row();
-            ui.label("knee torque");
-            ui.label(format!("{:+.1} N·m", sim.knee_torque()));
-            ui.end_row();
-            ui.label("frame / sim");
-            ui.label(format!("{:.1} ms / {:.1} ms", self.frame_ms, self.sim_ms));
-            ui.end_row();
-            // The core's own step timers, since the start: how fast the model runs here
-            // and how much of it the tissue takes.
-            let t = sim.timers();
-            if let Some(f) = t.realtime_factor() {
-                ui.label("stepping");
-                ui.label(format!(
-                    "{f:.2}× real time, tissue {:.0} %",
-                    100.0 * t.tissue_wall_s / t.wall_s
-                ));
-                ui.end_row();
-            }
-            ui.label("elements");
-            ui.label(format!(
-                "{} fat hex, {} muscles, {} bones",
-                lat.fat.hexes.len(),
-                lat.muscles.len(),
-                lat.bones.len()
-            ));
-            ui.end_row();
-            if let Some(m) = sim.tissue_metrics() {
-                ui.label("tissue");
-                ui.label(format!(
-                    "min vol {:.2}, max |ΔA| {:.2}, folded (VTK) {}",
-                    m.min_volume_ratio, m.max_abs_area_change, m.inverted
-                ));
-                ui.end_row();
-            }
-            if let Some(t) = sim.tissue() {
-                let g = t.guard_tally();
-                ui.label("guard");
-                ui.label(format!(
-                    "stepped in at {} updates ({} vertices)",
-                    g.updates, g.vertices
-                ));
-                ui.end_row();
-            }
-            if !sim.warnings().is_empty() {
-                ui.label("warnings");
-                ui.label(format!(
-                    "{} muscles built from the default rule",
-                    sim.warnings().len()
-                ))
-                .on_hover_text(sim.warnings().join("\n"));
-                ui.end_row();
-            }
-        });
     }
 
     fn playback(&mut self, ui: &mut egui::Ui, actions: &mut Vec<UiAction>) {
@@ -605,7 +541,12 @@ mod tests {
         let mut out = ctx.run_ui(egui::RawInput::default(), |_| {});
         out.textures_delta.clear();
         // Every character the interface's sources write, comments included (a superset).
-        let text: String = [include_str!("ui.rs"), include_str!("app.rs")].concat();
+        let text: String = [
+            include_str!("ui.rs"),
+            include_str!("app.rs"),
+            include_str!("readouts.rs"),
+        ]
+        .concat();
         let mut chars: Vec<char> = text.chars().filter(|c| !c.is_control()).collect();
         chars.sort_unstable();
         chars.dedup();

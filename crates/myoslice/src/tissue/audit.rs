@@ -132,23 +132,21 @@ impl Tissue {
     /// rest place. Exact (see the module); a second or so on a whole leg.
     pub fn audit(&self, frames: &BodyFrames) -> TissueAudit {
         let fat = &self.fat;
-        let (folded_fat, under_half, min_ratio) = fat
+        // Per element in parallel, then summed in order (the same on one thread: a web
+        // page has no pool).
+        let per: Vec<(bool, f32)> = fat
             .hexes
             .par_iter()
             .zip(&fat.rest_volume)
             .map(|(h, &v0)| {
                 let r = (f64::from(hex_volume_f32(&fat.x, h)) / v0) as f32;
-                (
-                    usize::from(!hex_is_valid(&fat.x, h)),
-                    usize::from(r < 0.5),
-                    r,
-                )
+                (!hex_is_valid(&fat.x, h), r)
             })
-            .reduce(
-                || (0, 0, f32::INFINITY),
-                |a, b| (a.0 + b.0, a.1 + b.1, a.2.min(b.2)),
-            );
-        let fat_off_rest_m = fat
+            .collect();
+        let folded_fat = per.iter().filter(|p| p.0).count();
+        let under_half = per.iter().filter(|p| p.1 < 0.5).count();
+        let min_ratio = per.iter().map(|p| p.1).fold(f32::INFINITY, f32::min);
+        let off_rest: Vec<f32> = fat
             .x
             .par_iter()
             .zip(&fat.rest)
@@ -157,7 +155,8 @@ impl Tissue {
                 let body = if thigh { BodyId::Thigh } else { BodyId::Shank };
                 x.distance(frames.point(body, *r))
             })
-            .reduce(|| 0.0, f32::max);
+            .collect();
+        let fat_off_rest_m = off_rest.into_iter().fold(0.0, f32::max);
         let muscle_volume_ratio = self
             .muscles
             .iter()
