@@ -154,7 +154,6 @@ fn a_tissue_updated_at_rest_stays_at_rest() {
         assert!(t.update(0.0, &rest, sim.muscles()));
     }
     let a = t.audit(&rest);
-    eprintln!("{a:?}");
     assert_eq!(a.folded_fat, 0);
     assert!(
         a.fat_off_rest_m < 1e-4,

@@ -17,7 +17,8 @@ const PULL_ACROSS: f32 = 0.7;
 const PULL_ALONG: f32 = 0.15;
 
 /// Where each inner fat vertex facing a muscle (`muscle_ref`: fat vertex → muscle, its
-/// vertex and the rest offset from the surface under it) goes this update, with the direction across its fat layer, into `out`.
+/// vertex and the rest offset from the surface under it) goes this update, with the
+/// direction across its fat layer, into `out`.
 /// `safe` is the knee fold of the rest shape and `weights` the fold's weight of each
 /// vertex; `thigh_turn`, `axis` and `theta` the thigh's rotation, the knee axis and angle.
 /// The vertex keeps its rest offset from its muscle vertex turned as the tissue about it
