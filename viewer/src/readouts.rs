@@ -3,7 +3,7 @@
 //! would measure it).
 
 use myoslice::Simulation;
-use myoslice::tissue::{SkinBreach, TissueAudit};
+use myoslice::tissue::TissueAudit;
 
 use crate::ui::UiState;
 
@@ -13,72 +13,6 @@ use crate::ui::UiState;
 pub struct AuditReadout {
     /// Simulated time (s) and tissue update of the audit, and the audit.
     last: Option<(f64, u64, TissueAudit)>,
-}
-
-/// One line of the audit: what was checked, what was found, and whether it holds.
-#[derive(Debug, Clone, PartialEq)]
-pub struct AuditLine {
-    /// What was checked.
-    pub check: &'static str,
-    /// What was found.
-    pub found: String,
-    /// Whether it holds (the tissue issue's bound).
-    pub holds: bool,
-}
-
-/// The lines of an audit: the tissue issue's must-holds, each with what was found.
-pub fn audit_lines(a: &TissueAudit) -> Vec<AuditLine> {
-    let breach = |b: Option<SkinBreach>| match b {
-        Some(b) => (
-            format!("{} ({:.1} mm)", b.vertices_over_1mm, b.farthest_m * 1e3),
-            b.vertices_over_1mm == 0,
-        ),
-        None => ("skin not closed".to_string(), false),
-    };
-    let line = |check, (found, holds)| AuditLine {
-        check,
-        found,
-        holds,
-    };
-    let overlap = |o: myoslice::tissue::Overlap| {
-        (
-            format!("{} ({:.1} mm)", o.vertices_over_1mm, o.deepest_m * 1e3),
-            o.vertices_over_1mm == 0,
-        )
-    };
-    let [lo, hi] = a.muscle_volume_ratio;
-    vec![
-        line("folded fat", (a.folded_fat.to_string(), a.folded_fat == 0)),
-        line(
-            "fat under half volume",
-            (
-                format!(
-                    "{} (least {:.2})",
-                    a.fat_under_half_volume, a.min_fat_volume_ratio
-                ),
-                a.fat_under_half_volume == 0,
-            ),
-        ),
-        line("muscle out of skin", breach(a.muscles_out_of_skin)),
-        line("bone out of skin", breach(a.bones_out_of_skin)),
-        line("muscle in bone", overlap(a.muscles_in_bone)),
-        line("muscle in muscle", overlap(a.muscles_in_muscles)),
-        line(
-            "skin crossings",
-            (a.skin_crossings.to_string(), a.skin_crossings == 0),
-        ),
-        line(
-            "muscle volumes",
-            (
-                format!("{lo:.3}..{hi:.3}"),
-                (0.99..=1.01).contains(&lo) && (0.99..=1.01).contains(&hi),
-            ),
-        ),
-        line(
-            "fat off rest",
-            (format!("{:.1} mm", a.fat_off_rest_m * 1e3), true),
-        ),
-    ]
 }
 
 impl AuditReadout {
@@ -126,7 +60,7 @@ impl AuditReadout {
                     }
                 ));
                 egui::Grid::new("audit").num_columns(2).show(ui, |ui| {
-                    for l in audit_lines(a) {
+                    for l in a.lines() {
                         ui.label(l.check);
                         let colour = if l.holds {
                             ui.visuals().text_color()
@@ -224,7 +158,7 @@ mod tests {
         r.run(&sim);
         let (time, update, a) = r.last().unwrap();
         assert_eq!((*time, *update), (0.0, 0));
-        let lines = audit_lines(a);
+        let lines = a.lines();
         assert_eq!(lines.len(), 9);
         let folded = &lines[0];
         assert_eq!(folded.found, a.folded_fat.to_string());
@@ -237,7 +171,8 @@ mod tests {
         assert!(!in_muscle.holds, "{in_muscle:?}");
         let mut bad = *a;
         bad.skin_crossings = 3;
-        let crossings = audit_lines(&bad)
+        let crossings = bad
+            .lines()
             .into_iter()
             .find(|l| l.check == "skin crossings");
         assert_eq!(

@@ -356,65 +356,11 @@ fn run_scenario(a: &RunArgs) -> Result<()> {
 
 /// The worst of each tissue check over an audited run, and where it ended.
 fn print_audit(r: &myoslice::export::RunAudit) {
-    let breach = |b: Option<myoslice::tissue::SkinBreach>| {
-        b.map_or("unmeasured (skin not closed)".to_string(), |b| {
-            format!(
-                "{} (farthest {:.1} mm)",
-                b.vertices_over_1mm,
-                b.farthest_m * 1e3
-            )
-        })
-    };
-    let (w, l) = (&r.worst, &r.last);
     println!("audit of {} tissue updates, worst (last):", r.updates);
-    println!(
-        "  folded fat elements          {} ({})",
-        w.folded_fat, l.folded_fat
-    );
-    println!(
-        "  fat elements under half      {} ({}), smallest volume ratio {:.3} ({:.3})",
-        w.fat_under_half_volume,
-        l.fat_under_half_volume,
-        w.min_fat_volume_ratio,
-        l.min_fat_volume_ratio
-    );
-    println!(
-        "  muscle vertices out of skin  {} ({})",
-        breach(w.muscles_out_of_skin),
-        breach(l.muscles_out_of_skin)
-    );
-    println!(
-        "  bone vertices out of skin    {} ({})",
-        breach(w.bones_out_of_skin),
-        breach(l.bones_out_of_skin)
-    );
-    for (name, a, b) in [
-        (
-            "in bone   ",
-            w.muscles_in_bone.vertices_over_1mm,
-            w.muscles_in_bone.deepest_m,
-        ),
-        (
-            "in muscle ",
-            w.muscles_in_muscles.vertices_over_1mm,
-            w.muscles_in_muscles.deepest_m,
-        ),
-    ] {
-        println!("  muscle vertices {name}   {a} (deepest {:.1} mm)", b * 1e3);
+    for (w, l) in r.worst.lines().into_iter().zip(r.last.lines()) {
+        let mark = if w.holds { " " } else { "!" };
+        println!("{mark} {:24} {} ({})", w.check, w.found, l.found);
     }
-    println!(
-        "  skin crossings               {} ({})",
-        w.skin_crossings, l.skin_crossings
-    );
-    println!(
-        "  muscle volume ratio          {:.3}..{:.3}",
-        w.muscle_volume_ratio[0], w.muscle_volume_ratio[1]
-    );
-    println!(
-        "  fat off its rest place       {:.1} mm ({:.1} mm at the end)",
-        w.fat_off_rest_m * 1e3,
-        l.fat_off_rest_m * 1e3
-    );
 }
 
 fn probe(a: &ProbeArgs) -> Result<()> {

@@ -97,8 +97,9 @@ pub struct RunWriter {
     dir: PathBuf,
     outputs: RunOutputs,
     csv: std::io::BufWriter<std::fs::File>,
-    /// `audit.csv`, when auditing, and the tissue update audited last.
-    audit_csv: Option<(std::io::BufWriter<std::fs::File>, u64)>,
+    /// `audit.csv`, when auditing, and the tissue update audited last (None before the
+    /// first).
+    audit_csv: Option<(std::io::BufWriter<std::fs::File>, Option<u64>)>,
     pvd: Vec<(f64, String)>,
     glb_times: Vec<f32>,
     skin_frames: Vec<Vec<Vec3>>,
@@ -125,18 +126,15 @@ impl RunWriter {
             header += &format!(",{n}_excitation,{n}_activation,{n}_force_n");
         }
         writeln!(csv, "{header}").map_err(|e| werr(&csv_path, e))?;
-        let audit_csv = match (outputs.audit, sim.tissue()) {
-            (true, Some(t)) => {
-                let p = dir.join("audit.csv");
-                let f = std::fs::File::create(&p).map_err(|e| werr(&p, e))?;
-                let mut f = std::io::BufWriter::new(f);
-                let head = TissueAudit::CSV_HEADER;
-                writeln!(f, "time_s,knee_angle_deg,tissue_update,{head}")
-                    .map_err(|e| werr(&p, e))?;
-                // The tissue as built is audited as update 0.
-                Some((f, t.updates().wrapping_sub(1)))
-            }
-            _ => None,
+        let audit_csv = if outputs.audit && sim.tissue().is_some() {
+            let p = dir.join("audit.csv");
+            let f = std::fs::File::create(&p).map_err(|e| werr(&p, e))?;
+            let mut f = std::io::BufWriter::new(f);
+            let head = TissueAudit::CSV_HEADER;
+            writeln!(f, "time_s,knee_angle_deg,tissue_update,{head}").map_err(|e| werr(&p, e))?;
+            Some((f, None))
+        } else {
+            None
         };
         let mut w = Self {
             dir: dir.to_path_buf(),
@@ -204,10 +202,10 @@ impl RunWriter {
         let (Some((csv, seen)), Some(t)) = (self.audit_csv.as_mut(), sim.tissue()) else {
             return Ok(());
         };
-        if t.updates() == *seen {
+        if *seen == Some(t.updates()) {
             return Ok(());
         }
-        *seen = t.updates();
+        *seen = Some(t.updates());
         let start = web_time::Instant::now();
         let a = t.audit(sim.frames());
         let line = format!(

@@ -5,7 +5,10 @@
 
 use serde::Serialize;
 
-use super::{BoneOverlap, MuscleOverlap, Overlap, SkinBreach, Tissue};
+use glam::Vec3;
+
+use super::skin_breach::breaches_of;
+use super::{BoneOverlap, MuscleOverlap, MuscleShape, Overlap, SkinBreach, Tissue};
 use crate::body::BodyId;
 use crate::lattice::{hex_is_valid, hex_volume_f32};
 use crate::muscle::BodyFrames;
@@ -41,6 +44,17 @@ pub struct TissueAudit {
     pub finite: bool,
 }
 
+/// One line of the audit: what was checked, what was found, and whether it holds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AuditLine {
+    /// What was checked.
+    pub check: &'static str,
+    /// What was found.
+    pub found: String,
+    /// Whether it holds (the tissue issue's bound).
+    pub holds: bool,
+}
+
 fn worse_breach(a: Option<SkinBreach>, b: Option<SkinBreach>) -> Option<SkinBreach> {
     match (a, b) {
         (Some(a), Some(b)) => Some(SkinBreach {
@@ -51,14 +65,71 @@ fn worse_breach(a: Option<SkinBreach>, b: Option<SkinBreach>) -> Option<SkinBrea
     }
 }
 
-fn sum_breach(b: Option<Vec<SkinBreach>>) -> Option<SkinBreach> {
-    b.map(|v| SkinBreach {
+fn sum_breach(v: &[SkinBreach]) -> SkinBreach {
+    SkinBreach {
         vertices_over_1mm: v.iter().map(|b| b.vertices_over_1mm).sum(),
         farthest_m: v.iter().map(|b| b.farthest_m).fold(0.0, f32::max),
-    })
+    }
 }
 
 impl TissueAudit {
+    /// The audit line by line: each of the tissue issue's must-holds, what was found and
+    /// whether it holds (the fat's distance from rest is shown, not judged).
+    pub fn lines(&self) -> Vec<AuditLine> {
+        let a = self;
+        let breach = |b: Option<SkinBreach>| match b {
+            Some(b) => (
+                format!("{} ({:.1} mm)", b.vertices_over_1mm, b.farthest_m * 1e3),
+                b.vertices_over_1mm == 0,
+            ),
+            None => ("skin not closed".to_string(), false),
+        };
+        let line = |check, (found, holds)| AuditLine {
+            check,
+            found,
+            holds,
+        };
+        let overlap = |o: Overlap| {
+            (
+                format!("{} ({:.1} mm)", o.vertices_over_1mm, o.deepest_m * 1e3),
+                o.vertices_over_1mm == 0,
+            )
+        };
+        let [lo, hi] = a.muscle_volume_ratio;
+        vec![
+            line("folded fat", (a.folded_fat.to_string(), a.folded_fat == 0)),
+            line(
+                "fat under half volume",
+                (
+                    format!(
+                        "{} (least {:.2})",
+                        a.fat_under_half_volume, a.min_fat_volume_ratio
+                    ),
+                    a.fat_under_half_volume == 0,
+                ),
+            ),
+            line("muscle out of skin", breach(a.muscles_out_of_skin)),
+            line("bone out of skin", breach(a.bones_out_of_skin)),
+            line("muscle in bone", overlap(a.muscles_in_bone)),
+            line("muscle in muscle", overlap(a.muscles_in_muscles)),
+            line(
+                "skin crossings",
+                (a.skin_crossings.to_string(), a.skin_crossings == 0),
+            ),
+            line(
+                "muscle volumes",
+                (
+                    format!("{lo:.3}..{hi:.3}"),
+                    (0.99..=1.01).contains(&lo) && (0.99..=1.01).contains(&hi),
+                ),
+            ),
+            line(
+                "fat off rest",
+                (format!("{:.1} mm", a.fat_off_rest_m * 1e3), true),
+            ),
+        ]
+    }
+
     /// The worse of two audits, field by field: over a run, its worst moment for each
     /// check (a skin that could not be closed once stays unmeasured).
     ///
@@ -160,19 +231,26 @@ impl Tissue {
         let muscle_volume_ratio = self
             .muscles
             .iter()
-            .map(|m| (m.volume_now / m.rest_volume.max(1e-12)) as f32)
+            .map(MuscleShape::volume_ratio)
             .fold([f32::INFINITY, f32::NEG_INFINITY], |[lo, hi], r| {
                 [lo.min(r), hi.max(r)]
             });
+        // One closed skin for every check against it.
+        let skin = self.fixed.skin.vertices(&fat.x);
+        let mesh = self.fixed.skin.mesh(&skin);
+        let bones = self.bone_points(frames);
+        let bones: Vec<&[Vec3]> = bones.iter().map(Vec::as_slice).collect();
+        let out_of_skin =
+            |sets: &[&[Vec3]]| mesh.as_ref().map(|m| sum_breach(&breaches_of(m, sets)));
         TissueAudit {
             folded_fat,
             fat_under_half_volume: under_half,
             min_fat_volume_ratio: min_ratio,
-            muscles_out_of_skin: sum_breach(self.muscles_outside_skin()),
-            bones_out_of_skin: sum_breach(self.bones_outside_skin(frames)),
+            muscles_out_of_skin: out_of_skin(&self.muscle_points()),
+            bones_out_of_skin: out_of_skin(&bones),
             muscles_in_bone: Overlap::total(&self.muscles_in_bone(frames)),
             muscles_in_muscles: Overlap::total(&self.muscles_in_muscles()),
-            skin_crossings: self.fixed.skin.crossings(&fat.x),
+            skin_crossings: self.fixed.skin.crossings(&skin),
             muscle_volume_ratio,
             fat_off_rest_m,
             finite: fat.x.iter().all(|p| p.is_finite())

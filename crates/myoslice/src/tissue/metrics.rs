@@ -4,7 +4,7 @@ use std::sync::OnceLock;
 
 use glam::{Mat3, Vec3};
 
-use super::Tissue;
+use super::{MuscleShape, Tissue};
 use crate::par::*;
 
 use super::polar::{covariance, polar_rotation_exact, rotation_step};
@@ -100,11 +100,8 @@ impl TissueMetrics {
                 area_change[h as usize] = (quad_area(&fat.x, &quad) / a0 - 1.0) as f32;
             }
         }
-        let muscle_volume_ratio: Vec<f32> = t
-            .muscles
-            .iter()
-            .map(|m| (m.volume_now / m.rest_volume.max(1e-12)) as f32)
-            .collect();
+        let muscle_volume_ratio: Vec<f32> =
+            t.muscles.iter().map(MuscleShape::volume_ratio).collect();
         Self {
             min_volume_ratio: volume_ratio.iter().copied().fold(f32::INFINITY, f32::min),
             max_abs_area_change: area_change.iter().map(|a| a.abs()).fold(0.0, f32::max),

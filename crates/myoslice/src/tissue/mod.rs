@@ -38,7 +38,7 @@ use crate::par::*;
 use glam::{Quat, Vec3};
 use parry3d::shape::TriMesh;
 
-pub use audit::TissueAudit;
+pub use audit::{AuditLine, TissueAudit};
 pub use fat_solver::FatSolver;
 pub use guard_tally::GuardTally;
 pub use knee_fold::{Contact, FoldZone, KneeFold};

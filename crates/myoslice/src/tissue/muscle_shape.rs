@@ -405,6 +405,11 @@ impl MuscleShape {
         self.keep.near_plane()
     }
 
+    /// Volume over rest volume, as the last placement measured it.
+    pub fn volume_ratio(&self) -> f32 {
+        (self.volume_now / self.rest_volume.max(1e-12)) as f32
+    }
+
     /// Enclosed volume now (m³), measured anew.
     pub fn volume(&self) -> f64 {
         signed_volume(&self.current, &self.triangles).abs()

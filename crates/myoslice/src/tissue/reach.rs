@@ -34,8 +34,7 @@ impl Tissue {
     /// (exact: the skin closed at both ends of the lattice, a tree query per muscle
     /// vertex; for checks, not for every update). None when the skin is degenerate.
     pub fn muscles_outside_skin(&self) -> Option<Vec<SkinBreach>> {
-        let muscles: Vec<&[Vec3]> = self.muscles.iter().map(|m| m.current.as_slice()).collect();
-        self.fixed.skin.breaches(&self.fat.x, &muscles)
+        self.fixed.skin.breaches(&self.fat.x, &self.muscle_points())
     }
 
     /// How far each bone's surface reaches out through the skin with the bodies at
@@ -43,8 +42,19 @@ impl Tissue {
     /// [`Tissue::muscles_outside_skin`]; for checks, not for every update). None when the
     /// skin is degenerate.
     pub fn bones_outside_skin(&self, frames: &BodyFrames) -> Option<Vec<SkinBreach>> {
-        let bones: Vec<Vec<Vec3>> = self
-            .fixed
+        let bones = self.bone_points(frames);
+        let bones: Vec<&[Vec3]> = bones.iter().map(Vec::as_slice).collect();
+        self.fixed.skin.breaches(&self.fat.x, &bones)
+    }
+
+    /// Each muscle's vertices now, in muscle order.
+    pub(super) fn muscle_points(&self) -> Vec<&[Vec3]> {
+        self.muscles.iter().map(|m| m.current.as_slice()).collect()
+    }
+
+    /// Each bone's vertices with the bodies at `frames`, in the lattice's bone order.
+    pub(super) fn bone_points(&self, frames: &BodyFrames) -> Vec<Vec<Vec3>> {
+        self.fixed
             .bones
             .iter()
             .map(|(body, m)| {
@@ -53,9 +63,7 @@ impl Tissue {
                     .map(|&p| frames.point(*body, p))
                     .collect()
             })
-            .collect();
-        let bones: Vec<&[Vec3]> = bones.iter().map(Vec::as_slice).collect();
-        self.fixed.skin.breaches(&self.fat.x, &bones)
+            .collect()
     }
 }
 

@@ -5,6 +5,7 @@
 use crate::par::*;
 use glam::Vec3;
 use parry3d::query::PointQuery;
+use parry3d::shape::TriMesh;
 
 use crate::lattice::{FatLattice, oriented_trimesh};
 
@@ -86,39 +87,51 @@ impl ClosedSkin {
         }
     }
 
-    /// Pairs of skin triangles (sharing no vertex) that cross, with the fat vertices at
-    /// `fat_x`: the skin passing through itself.
-    pub(crate) fn crossings(&self, fat_x: &[Vec3]) -> usize {
-        let v: Vec<Vec3> = self.used.iter().map(|&i| fat_x[i as usize]).collect();
-        crate::tissue::intersect::self_intersections(&v, &self.triangles[..self.sides])
-    }
-
-    /// How far each of `muscles` (vertex lists) reaches out through the skin with the fat
-    /// vertices at `fat_x`. None when the skin is degenerate.
-    pub(crate) fn breaches(&self, fat_x: &[Vec3], muscles: &[&[Vec3]]) -> Option<Vec<SkinBreach>> {
+    /// The closed skin's vertices with the fat vertices at `fat_x`: the skin's, then the
+    /// centres of the two end fans.
+    pub(crate) fn vertices(&self, fat_x: &[Vec3]) -> Vec<Vec3> {
         let mut v: Vec<Vec3> = self.used.iter().map(|&i| fat_x[i as usize]).collect();
         let centres = self
             .ends
             .each_ref()
             .map(|r| r.iter().map(|&i| v[i as usize]).sum::<Vec3>() / r.len().max(1) as f32);
         v.extend(centres);
-        let mesh = oriented_trimesh(&v, &self.triangles)?;
-        Some(
-            muscles
-                .par_iter()
-                .map(|m| {
-                    let mut b = SkinBreach::default();
-                    for &p in *m {
-                        let proj = mesh.project_local_point(p, false);
-                        if !proj.is_inside {
-                            let d = proj.point.distance(p);
-                            b.farthest_m = b.farthest_m.max(d);
-                            b.vertices_over_1mm += usize::from(d > 1e-3);
-                        }
-                    }
-                    b
-                })
-                .collect(),
-        )
+        v
     }
+
+    /// The closed skin as a mesh at `vertices` ([`Self::vertices`]); None when degenerate.
+    pub(crate) fn mesh(&self, vertices: &[Vec3]) -> Option<TriMesh> {
+        oriented_trimesh(vertices, &self.triangles)
+    }
+
+    /// Pairs of skin triangles (sharing no vertex) that cross at `vertices`
+    /// ([`Self::vertices`]): the skin passing through itself.
+    pub(crate) fn crossings(&self, vertices: &[Vec3]) -> usize {
+        crate::tissue::intersect::self_intersections(vertices, &self.triangles[..self.sides])
+    }
+
+    /// How far each of `muscles` (vertex lists) reaches out through the skin with the fat
+    /// vertices at `fat_x`. None when the skin is degenerate.
+    pub(crate) fn breaches(&self, fat_x: &[Vec3], muscles: &[&[Vec3]]) -> Option<Vec<SkinBreach>> {
+        let mesh = self.mesh(&self.vertices(fat_x))?;
+        Some(breaches_of(&mesh, muscles))
+    }
+}
+
+/// How far each of `sets` (vertex lists) reaches out through the closed skin `mesh`.
+pub(crate) fn breaches_of(mesh: &TriMesh, sets: &[&[Vec3]]) -> Vec<SkinBreach> {
+    sets.par_iter()
+        .map(|m| {
+            let mut b = SkinBreach::default();
+            for &p in *m {
+                let proj = mesh.project_local_point(p, false);
+                if !proj.is_inside {
+                    let d = proj.point.distance(p);
+                    b.farthest_m = b.farthest_m.max(d);
+                    b.vertices_over_1mm += usize::from(d > 1e-3);
+                }
+            }
+            b
+        })
+        .collect()
 }
