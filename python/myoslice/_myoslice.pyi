@@ -89,6 +89,8 @@ class Simulation:
         max_step_s: float = 0.001,
         chain_tether: float | None = None,
         chain_tether_release_n: float | None = None,
+        chain_contact: bool | None = None,
+        muscle_contact: bool | None = None,
         voxel_mm: float | None = None,
     ) -> Simulation:
         """The built-in lower-limb phantom (no files needed).
@@ -103,7 +105,10 @@ class Simulation:
         ``chain_tether`` (N/m) pulls each relaxed muscle's chain points toward where they
         rest on their bones (``None``: the default, 600; ``0``: the paper's free chain),
         fading out as the muscle's force rises to ``chain_tether_release_n`` (N; ``None``:
-        the default, 20).
+        the default, 20). ``chain_contact`` keeps muscles' chains off one another
+        (``None``: the default, on); ``muscle_contact`` pushes overlapping muscle shapes
+        apart after each tissue update places them, keeping their volumes (``None``: the
+        default, off: it roughly doubles the tissue's time).
         """
 
     @staticmethod
@@ -126,6 +131,8 @@ class Simulation:
         max_step_s: float = 0.001,
         chain_tether: float | None = None,
         chain_tether_release_n: float | None = None,
+        chain_contact: bool | None = None,
+        muscle_contact: bool | None = None,
     ) -> Simulation:
         """A model from a label volume (NIfTI-1/-2 or NRRD; an oblique or reordered scan is
         brought into the body frame) or a PNG stack (its folder or manifest), told apart

@@ -22,6 +22,10 @@ pub(crate) struct ConfigArgs<'a> {
     pub(crate) chain_tether: Option<f64>,
     /// None: the core's default.
     pub(crate) chain_tether_release_n: Option<f64>,
+    /// None: the core's default.
+    pub(crate) chain_contact: Option<bool>,
+    /// None: the core's default.
+    pub(crate) muscle_contact: Option<bool>,
 }
 
 impl ConfigArgs<'_> {
@@ -41,10 +45,14 @@ impl ConfigArgs<'_> {
             chain_tether_release_n: self
                 .chain_tether_release_n
                 .unwrap_or(d.chain_tether_release_n),
+            chain_contact: self.chain_contact.unwrap_or(d.chain_contact),
             ..d
         };
         c.tissue.enabled = self.tissue;
         c.tissue.rate_hz = self.tissue_rate_hz;
+        if let Some(on) = self.muscle_contact {
+            c.tissue.muscle_contact = on;
+        }
         if let Some(n) = self.tissue_iterations {
             c.tissue.iterations = usize::try_from(n).map_err(|_| {
                 py_err(

@@ -284,6 +284,19 @@ def test_audit_sums_the_per_muscle_measures(tissue: Simulation, rigid: Simulatio
     assert rigid.audit() is None
 
 
+def test_muscle_contact_presses_fewer_muscle_vertices_into_their_neighbours() -> None:
+    found = []
+    for on in (False, True):
+        sim = Simulation.phantom(muscle_contact=on, chain_contact=True)
+        flex(sim, 0.3)
+        a = sim.audit()
+        assert a is not None
+        lo, hi = a["muscle_volume_ratio"]
+        assert 0.99 < lo <= hi < 1.01, (on, lo, hi)
+        found.append(a["muscles_in_muscles"]["vertices_over_1mm"])
+    assert found[1] < found[0], found
+
+
 def test_bones_outside_skin_per_bone(tissue: Simulation, rigid: Simulation) -> None:
     r = tissue.bones_outside_skin()
     assert set(r) == {"vertices_over_1mm", "farthest_m"}

@@ -22,10 +22,12 @@
 //! initial_knee_deg = 0.0      # default 0
 //! chain_tether = 600.0        # N/m pulling relaxed chains to rest, 0 = off (default 600)
 //! chain_tether_release_n = 20.0  # muscle force (N) where the tether lets go (default 20)
+//! chain_contact = true        # muscles' chains keep off one another (default true)
 //! excitation_scale = 1.0      # factor on every [excitation] value (capped at 1), default 1
 //!
 //! [tissue]                    # every TissueConfig field, all optional
 //! rate_hz = 30.0
+//! muscle_contact = false      # push overlapping muscle shapes apart (default false: slow)
 //!
 //! [excitation]                # per muscle or group: [[time s, value], ...]
 //! hamstrings = [[0.0, 0.0], [0.2, 0.6]]
@@ -150,6 +152,10 @@ pub struct SimulationSection {
     /// ([`SimulationConfig::chain_tether_release_n`]); its default when absent.
     #[serde(default)]
     pub chain_tether_release_n: Option<f64>,
+    /// Whether muscles' chains press on one another
+    /// ([`SimulationConfig::chain_contact`]); its default when absent.
+    #[serde(default)]
+    pub chain_contact: Option<bool>,
     /// Factor on every excitation schedule's values (capped at 1); 1 when absent.
     #[serde(default = "one")]
     pub excitation_scale: f64,
@@ -396,6 +402,7 @@ impl Scenario {
             max_step_s: s.step_s,
             chain_tether: s.chain_tether.unwrap_or(d.chain_tether),
             chain_tether_release_n: s.chain_tether_release_n.unwrap_or(d.chain_tether_release_n),
+            chain_contact: s.chain_contact.unwrap_or(d.chain_contact),
             tissue: self.tissue.clone(),
             ..d
         }

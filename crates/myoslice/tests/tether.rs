@@ -1,5 +1,5 @@
 //! The tether of an unloaded chain: through a flexion by the hamstrings and back, the
-//! relaxed calf muscles' chain points stay near where they rest on their bones.
+//! relaxed calf muscles' chain points stay near where they were built on their bones.
 
 #![allow(clippy::unwrap_used)] // tests fail loudly by design
 
@@ -76,8 +76,8 @@ fn relaxed_calf_muscles_stay_near_their_rest_places_through_a_flexion_and_back()
     );
     eprintln!("{summary}");
     assert!(deep > 90.0 && deep0 > 90.0, "{summary}");
-    // The rest places are the chains' own equilibrium at rest, which they settle to with
-    // or without the tether.
-    assert!(rest < 2e-4 && rest0 < 2e-4, "{summary}");
+    // The rest places are where the chains were built: at rest the tether holds them
+    // there (within a millimetre), while without it they sag and straighten away.
+    assert!(rest < 1e-3 && rest < 0.5 * rest0, "{summary}");
     assert!(back < 0.5 * back0, "{summary}");
 }

@@ -35,8 +35,8 @@ pub struct ConeAnchor {
     pub depth: [f32; 2],
     /// The point's place at rest (body rest frame), where an unloaded chain's tether pulls
     /// it back to (see [`super::ChainLoad::tether`]): where [`MuscleChain::settle`] left it
-    /// (under its settling tension), which a `Simulation` replaces by the chains' passive
-    /// equilibrium at rest.
+    /// when the chain was built (under its settling tension), which is also where the
+    /// tissue rests on it.
     pub rest: Vec3,
 }
 

@@ -2,6 +2,7 @@
 
 pub mod catalogue;
 pub mod chain;
+pub mod contact;
 pub mod dynamics;
 pub mod excursion;
 pub mod hill;
@@ -14,6 +15,7 @@ pub mod wrap;
 
 pub use catalogue::{CatalogueEntry, MuscleCatalogue, MuscleGroup, ResolvedMuscle};
 pub use chain::{Attachment, BodyFrames, ConeAnchor, MuscleChain};
+pub use contact::ChainContact;
 pub use dynamics::{ChainLoad, ChainScratch, EndForces};
 pub use excursion::{Axis, Pull};
 pub use hill::{FibreState, HillForce, HillParams};

@@ -77,6 +77,9 @@ pub struct SimulationConfig {
     /// the tether off). The same for every muscle: 1.5 % of the vastus medialis' F_max,
     /// a quarter of the weakest catalogued muscles' (82 N). Default 20.
     pub chain_tether_release_n: f64,
+    /// Whether muscles press on one another: each chain point keeps its rest distance
+    /// from its neighbours' centre lines (see [`crate::muscle::ChainContact`]). Default on.
+    pub chain_contact: bool,
     /// Tissue deformation options.
     pub tissue: TissueConfig,
 }
@@ -98,6 +101,7 @@ impl Default for SimulationConfig {
             chain_stiffness: 0.5,
             chain_tether: 600.0,
             chain_tether_release_n: 20.0,
+            chain_contact: true,
             tissue: TissueConfig::default(),
         }
     }

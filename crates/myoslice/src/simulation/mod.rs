@@ -24,7 +24,8 @@ use crate::body::{BodyId, Skeleton, SkeletonOptions, knee_axis};
 use crate::error::{Error, Result, check_range};
 use crate::lattice::Lattice;
 use crate::muscle::{
-    Axis, BodyFrames, ChainLoad, ChainOptions, MuscleCatalogue, MuscleGroup, MuscleUnit,
+    Axis, BodyFrames, ChainContact, ChainLoad, ChainOptions, MuscleCatalogue, MuscleGroup,
+    MuscleUnit,
 };
 use crate::tissue::{BoneOverlap, SkinBreach, Tissue, TissueAudit, TissueMetrics, bone_surfaces};
 
@@ -93,6 +94,10 @@ pub struct Simulation {
     frames: BodyFrames,
     knee_torque: f64,
     tissue: Option<Tissue>,
+    /// The muscles' contacts with one another (found at rest, never changed).
+    contact: Arc<ChainContact>,
+    /// Which chains moved by their own dynamics in a substep (the others were carried).
+    moving: Vec<bool>,
     /// Per-substep buffers, kept to avoid allocating every step.
     scratch: (Vec<(Vec3, Vec3)>, Vec<ChainLoad>),
     /// Buffers for the state a `step` call started from.
@@ -184,6 +189,8 @@ impl Simulation {
             frames: BodyFrames::REST,
             knee_torque: 0.0,
             tissue: None,
+            contact: Arc::default(),
+            moving: Vec::new(),
             scratch: Default::default(),
             rollback: Rollback::default(),
             timers: StepTimers::default(),
@@ -192,19 +199,20 @@ impl Simulation {
         // Moment arms (each step's torque report uses the last step's) and wrap state of
         // the chains as built.
         sim.reattach_muscles();
-        // The chains' equilibrium at rest (see `settle`), found without the tether, is
-        // where the tether holds an unloaded chain and the tissue's rest; the simulation
-        // itself starts from the chains as built.
-        let mut rest = sim.clone();
-        rest.config.chain_tether = 0.0;
-        let settled = rest.settle();
-        for (m, r) in sim.muscles.iter_mut().zip(&rest.muscles) {
-            m.chain.set_rest_places(&r.chain.x, &settled);
+        // The tether holds an unloaded chain where it was built (along the muscle's
+        // centroids, under its build tension). The chains settle against it before the
+        // simulation starts, and the tissue rests on the settled chains, so a simulation
+        // that starts idle stays at rest. (A tissue resting on the chains' tether-free
+        // equilibrium, centimetres away near the knee, began every run by moving there:
+        // folded fat, muscles pressed into their neighbours.)
+        sim.settle();
+        if sim.config.chain_contact {
+            sim.contact = Arc::new(ChainContact::new(&sim.muscles, &sim.lattice.muscles));
         }
         if let Some(bones) = bones {
             sim.tissue = Some(Tissue::new(
                 &sim.lattice,
-                &rest.muscles,
+                &sim.muscles,
                 knee,
                 bones,
                 sim.config.tissue.clone(),
@@ -216,13 +224,12 @@ impl Simulation {
         Ok(sim)
     }
 
-    /// Lets the muscle chains settle at rest: a chain drawn along a curved muscle
-    /// straightens a little under its passive tension and sags under gravity, and the
-    /// tissue takes that equilibrium as its rest shape rather than showing the settling
-    /// as deformation. The skeleton is put back where it was; the clock stays at 0.
-    /// Returns the bodies' poses the chains settled at (the knee may have moved a little
-    /// before the skeleton was put back), which their interior points are relative to.
-    fn settle(&mut self) -> BodyFrames {
+    /// Lets the muscle chains settle at rest against their tether: a chain drawn along a
+    /// curved muscle straightens a little under its passive tension and sags under
+    /// gravity, and the tissue takes that equilibrium as its rest shape rather than
+    /// showing the settling as deformation. The skeleton is put back where it was; the
+    /// clock stays at 0.
+    fn settle(&mut self) {
         let skeleton = self.skeleton.clone();
         let muscles = self.muscles.clone();
         let h = self.config.max_step_s;
@@ -235,7 +242,6 @@ impl Simulation {
                 break;
             }
         }
-        let settled = self.current_frames();
         self.skeleton = skeleton;
         self.frames = self.current_frames();
         for m in &mut self.muscles {
@@ -243,7 +249,6 @@ impl Simulation {
         }
         self.reattach_muscles();
         (self.time, self.steps, self.knee_torque) = (0.0, 0, 0.0);
-        settled
     }
 
     /// After the bones moved by a jump: every chain back on its attachments, its wrap,

@@ -317,6 +317,8 @@ impl Simulation {
             point: next.point(BodyId::Thigh, knee.point),
             dir: next.vector(BodyId::Thigh, knee.axis),
         };
+        let mut moving = std::mem::take(&mut self.moving);
+        moving.clear();
         for (m, load) in self.muscles.iter_mut().zip(&loads) {
             // A muscle at rest on one body is carried with it; only loaded or
             // knee-crossing chains need their dynamics.
@@ -324,9 +326,13 @@ impl Simulation {
                 && m.activation < 1e-4
                 && m.force < 1e-3 * m.hill.max_isometric_force;
             match m.chain.single_body() {
-                Some(b) if quiet => m.chain.carry(b, &frames, &next, h as f32),
+                Some(b) if quiet => {
+                    m.chain.carry(b, &frames, &next, h as f32);
+                    moving.push(false);
+                }
                 _ => {
                     m.chain.advance(h as f32, &next, load);
+                    moving.push(true);
                 }
             }
             if hill {
@@ -339,6 +345,14 @@ impl Simulation {
                 );
                 m.activation = (m.activation + h * rate).clamp(0.0, 1.0);
             }
+        }
+        if self.contact.project(&mut self.muscles, &moving) {
+            for (m, _) in self.muscles.iter_mut().zip(&moving).filter(|(_, mv)| **mv) {
+                m.chain.update_wrap();
+            }
+        }
+        self.moving = moving;
+        for m in &mut self.muscles {
             m.path_length = m.chain.path_length();
             if m.crosses_knee {
                 // Computed once per step on the new geometry; the next step's torque

@@ -18,6 +18,7 @@ mod incidence;
 pub mod intersect;
 pub mod knee_fold;
 pub mod metrics;
+mod muscle_contact;
 mod muscle_overlap;
 mod muscle_placing;
 pub mod muscle_shape;
@@ -225,6 +226,13 @@ impl Tissue {
                 s
             })
             .collect();
+        let mut shapes = shapes;
+        if config.muscle_contact {
+            let free = muscle_contact::free_to_bulge(&shapes, &bone_sdfs);
+            for (s, f) in shapes.iter_mut().zip(free) {
+                s.bulges = Arc::new(f);
+            }
+        }
         let fat = &lattice.fat;
         let solver = FatSolver::new(&fat.vertices, &fat.hexes);
         let nv = fat.vertices.len();

@@ -77,10 +77,14 @@ impl Placing<'_> {
                         } else {
                             shape.carry(q, t);
                         }
+                        shape.carried = Some(b);
                     }
                     _ => shape.update_clear_of(&m.chain, &fold, &bones),
                 }
             });
+        if self.config.muscle_contact {
+            super::muscle_contact::separate(self.shapes);
+        }
         let finite = self
             .shapes
             .iter()

@@ -5,8 +5,11 @@
 
 use glam::{Mat3, Quat, Vec3, Vec3A};
 
+use std::sync::Arc;
+
 use super::bone_keep_out::{BoneKeepOut, Bones};
 use super::knee_fold::{Contact, KneeFold};
+use super::muscle_contact::{RingOutline, RingPose};
 use crate::body::BodyId;
 use crate::lattice::{MuscleLattice, signed_volume};
 use crate::muscle::MuscleChain;
@@ -14,7 +17,7 @@ use crate::muscle::MuscleChain;
 /// Most placement passes per update: each after the first corrects the cross-sections by
 /// the volume the previous one missed. Most updates need two; a small muscle whose rings
 /// were shifted far out of bone (plantaris by the condyle) needed more than five.
-const VOLUME_PASSES: usize = 12;
+pub(super) const VOLUME_PASSES: usize = 12;
 
 /// How many rings either way [`MuscleShape::surface_under`] looks, within the ring's
 /// tube (5 mm slices: 6 cm).
@@ -30,13 +33,25 @@ pub struct MuscleShape {
     /// Segment and fraction along it of each ring's centre.
     ring_param: Vec<(u32, f32)>,
     /// Ring index of each vertex.
-    ring_of: Vec<u32>,
+    pub(super) ring_of: Vec<u32>,
     /// First surface vertex of each ring; a ring's vertices are consecutive.
-    ring_first: Vec<u32>,
+    pub(super) ring_first: Vec<u32>,
     /// Surface vertices per ring.
-    ring_len: u32,
+    pub(super) ring_len: u32,
+    /// Centre vertex of each ring.
+    pub(super) ring_centre: Vec<u32>,
     /// First and last ring of each ring's tube (a muscle may be several tubes).
-    tube_of_ring: Vec<(u32, u32)>,
+    pub(super) tube_of_ring: Vec<(u32, u32)>,
+    /// Each ring's outline in its rest plane (for [`super::muscle_contact`]).
+    pub(super) outline: Arc<Vec<RingOutline>>,
+    /// How each ring sits now, as the last placement left it.
+    pub(super) pose: Vec<RingPose>,
+    /// The body this shape was carried by rigidly in the last update, if it was (not
+    /// placed on its chain): two shapes carried by one body keep their rest contact.
+    pub(crate) carried: Option<BodyId>,
+    /// Which vertices face fat at rest, and may bulge to keep the volume a contact
+    /// took (see [`super::muscle_contact::free_to_bulge`]); empty: all.
+    pub(super) bulges: Arc<Vec<bool>>,
     /// Axial offset and perpendicular offset of each vertex in its segment's rest frame.
     axial: Vec<f32>,
     perp: Vec<Vec3>,
@@ -123,7 +138,23 @@ impl MuscleShape {
             axial.push(ax);
             perp.push(o - u0 * ax);
         }
-        Self {
+        let outline = mesh
+            .rings
+            .iter()
+            .zip(&ring_param)
+            .map(|(r, &(seg, _))| {
+                let seg = seg as usize;
+                let u0 = (rest_chain[seg + 1] - rest_chain[seg]).normalize_or(Vec3::Z);
+                let f = r.first as usize;
+                RingOutline::new(u0, perp[r.centre as usize], &perp[f..f + n as usize])
+            })
+            .collect();
+        let mut shape = Self {
+            ring_centre: mesh.rings.iter().map(|r| r.centre).collect(),
+            outline: Arc::new(outline),
+            pose: Vec::new(),
+            bulges: Arc::default(),
+            carried: None,
             rest_chain,
             belly,
             ring_param,
@@ -139,7 +170,50 @@ impl MuscleShape {
             volume_now: mesh.volume().abs(),
             triangles: mesh.triangles.clone(),
             keep: BoneKeepOut::default(),
-        }
+        };
+        shape.carry(Quat::IDENTITY, Vec3::ZERO);
+        shape
+    }
+
+    /// The rings' poses of a shape carried rigidly by `(q, t)`, each ring's chain point
+    /// shifted by `shift` across its axis (none if empty).
+    fn carry_poses(&mut self, q: Quat, t: Vec3, shift: &[Vec3]) {
+        let m = Mat3::from_quat(q);
+        let poses: Vec<RingPose> = self
+            .rest_points()
+            .enumerate()
+            .map(|(r, (c, u0))| {
+                let axis = q * u0;
+                let sh = shift.get(r).copied().unwrap_or_default();
+                RingPose {
+                    c: m * c + t + (sh - axis * sh.dot(axis)),
+                    m,
+                    across: 1.0,
+                    axis,
+                }
+            })
+            .collect();
+        self.pose = poses;
+    }
+
+    /// The ring vertex `v` belongs to.
+    pub(super) fn ring_of_vertex(&self, v: usize) -> usize {
+        self.ring_of[v] as usize
+    }
+
+    /// Whether vertex `v` is a ring's centre (inside the muscle, not on its surface).
+    pub(super) fn is_centre(&self, v: usize) -> bool {
+        let f = self.ring_first[self.ring_of[v] as usize] as usize;
+        v < f || v >= f + self.ring_len as usize
+    }
+
+    /// Each ring's chain point at rest.
+    fn rest_points(&self) -> impl Iterator<Item = (Vec3, Vec3)> + '_ {
+        self.ring_param.iter().map(|&(s, t)| {
+            let s = s as usize;
+            let (a, b) = (self.rest_chain[s], self.rest_chain[s + 1]);
+            (a.lerp(b, t), (b - a).normalize_or(Vec3::Z))
+        })
     }
 
     /// The point nearest `p` on the line of surface vertices through `v` from ring to
@@ -280,6 +354,11 @@ impl MuscleShape {
         // contact plane flattens a muscle its volume need not grow with the scale, and
         // the passes can swing ever wider (the plantaris by the condyle went to ×20).
         let mut best = (f64::INFINITY, across_fix);
+        // The nearest scales found below and above the rest volume: where the volume
+        // grows faster than the square of the scale (rings crossing at a sharp bend),
+        // the square-root step overshoots back and forth, and the passes search between
+        // them instead.
+        let mut bracket: [Option<(f32, f64)>; 2] = [None, None];
         let mut pass = 0;
         loop {
             for (a, r) in across.iter_mut().zip(&root) {
@@ -317,11 +396,17 @@ impl MuscleShape {
             if miss < best.0 {
                 best = (miss, across_fix);
             }
+            bracket[usize::from(v > self.rest_volume)] = Some((across_fix, v));
             if pass == VOLUME_PASSES {
                 break;
             }
             match volume_fix(self.rest_volume, v, pass) {
-                Some(fix) => across_fix *= fix.clamp(0.8, 1.25),
+                Some(fix) => {
+                    across_fix = match bracket {
+                        [Some(lo), Some(hi)] => between(lo, hi, self.rest_volume),
+                        _ => across_fix * fix.clamp(0.8, 1.25),
+                    }
+                }
                 // Done; or out of passes, or no volume at all: then the best scale again
                 // (one more placement), unless this was it.
                 None if best.1 == across_fix => break,
@@ -333,6 +418,14 @@ impl MuscleShape {
             }
             pass += 1;
         }
+        self.carried = None;
+        self.pose.clear();
+        self.pose.extend(
+            rings
+                .iter()
+                .zip(&across)
+                .map(|(&(c, m, axis, _), &across)| RingPose { c, m, across, axis }),
+        );
     }
 
     /// Moves the whole shape rigidly with a body (rest → now).
@@ -341,6 +434,7 @@ impl MuscleShape {
         for (p, r) in self.current.iter_mut().zip(&self.rest) {
             *p = m * *r + t;
         }
+        self.carry_poses(q, t, &[]);
         self.keep.clear();
         self.volume_now = self.rest_volume;
     }
@@ -366,6 +460,9 @@ impl MuscleShape {
         }
         self.keep
             .clear_carried_rings(&mut self.current, &self.ring_of, |r| axes[r], bones, body);
+        let shift = std::mem::take(&mut self.keep.shift);
+        self.carry_poses(q, t, &shift);
+        self.keep.shift = shift;
         if self.keep.shift.iter().all(|s| *s == Vec3::ZERO) {
             self.volume_now = self.rest_volume;
             return;
@@ -420,15 +517,30 @@ impl MuscleShape {
 /// encloses `v` (m³) against `rest`: the square root of the volume ratio. None when the
 /// shape is close enough (within 2 × 10⁻⁴ of that factor), out of passes, or not a
 /// volume at all.
-fn volume_fix(rest: f64, v: f64, pass: usize) -> Option<f32> {
+pub(super) fn volume_fix(rest: f64, v: f64, pass: usize) -> Option<f32> {
     let fix = ((rest / v.max(1e-15)) as f32).sqrt();
     let done = (fix - 1.0).abs() < 2e-4 || pass + 1 == VOLUME_PASSES || v <= 0.0;
     (!done).then_some(fix)
 }
 
+/// The scale between `lo` and `hi` (scale, volume: one below `rest`, one above) where
+/// the volume, a power of the scale between them, meets `rest`; the middle of the two
+/// (geometric) if that falls outside.
+fn between(lo: (f32, f64), hi: (f32, f64), rest: f64) -> f32 {
+    let (l0, l1) = (f64::from(lo.0).ln(), f64::from(hi.0).ln());
+    let (v0, v1) = (lo.1.max(1e-18).ln(), hi.1.max(1e-18).ln());
+    let t = if v1 > v0 {
+        (rest.ln() - v0) / (v1 - v0)
+    } else {
+        0.5
+    };
+    let t = if (0.02..=0.98).contains(&t) { t } else { 0.5 };
+    (l0 + (l1 - l0) * t).exp() as f32
+}
+
 /// Enclosed volume (m³) of a closed triangle surface, summed about `origin` in single
 /// precision per triangle (double across them).
-fn volume_about(vertices: &[Vec3], triangles: &[[u32; 3]], origin: Vec3) -> f64 {
+pub(super) fn volume_about(vertices: &[Vec3], triangles: &[[u32; 3]], origin: Vec3) -> f64 {
     let mut v = 0.0f64;
     for chunk in triangles.chunks(64) {
         let mut part = 0.0f32;
@@ -478,6 +590,11 @@ mod tests {
             volume_now: 0.0,
             triangles: Vec::new(),
             keep: BoneKeepOut::default(),
+            ring_centre: Vec::new(),
+            outline: Arc::default(),
+            pose: Vec::new(),
+            bulges: Arc::default(),
+            carried: None,
         }
     }
 

@@ -274,6 +274,14 @@ pub fn muscles_in_bone_beyond(
 
 /// A fresh tissue of a simulation (its own copy, to move by hand).
 pub fn tissue_of(sim: &Simulation) -> myoslice::tissue::Tissue {
+    tissue_with(sim, Default::default())
+}
+
+/// [`tissue_of`] with the options `config`.
+pub fn tissue_with(
+    sim: &Simulation,
+    config: myoslice::tissue::TissueConfig,
+) -> myoslice::tissue::Tissue {
     let lat = sim.lattice();
     let meshes: Vec<_> = (0..lat.bones.len())
         .map(|i| sim.skeleton().bone_trimesh(i).unwrap())
@@ -283,7 +291,7 @@ pub fn tissue_of(sim: &Simulation) -> myoslice::tissue::Tissue {
         sim.muscles(),
         *sim.skeleton().knee(),
         myoslice::tissue::bone_surfaces(lat, &meshes),
-        Default::default(),
+        config,
     )
     .unwrap()
 }
