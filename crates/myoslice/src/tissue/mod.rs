@@ -218,7 +218,7 @@ impl Tissue {
             .map(|(_, m)| BoneSdf::new(m.vertices(), m.indices(), SDF_CELL_M, SDF_BAND_M))
             .collect();
         let rest_contact = KneeFold::new(&knee, 0.0).contact(0.0);
-        let shapes: Vec<MuscleShape> = muscles
+        let mut shapes: Vec<MuscleShape> = muscles
             .par_iter()
             .map(|m| {
                 let mut s = MuscleShape::new(&lattice.muscles[m.lattice_index], &m.chain);
@@ -226,7 +226,6 @@ impl Tissue {
                 s
             })
             .collect();
-        let mut shapes = shapes;
         if config.muscle_contact {
             let free = muscle_contact::free_to_bulge(&shapes, &bone_sdfs);
             for (s, f) in shapes.iter_mut().zip(free) {
