@@ -15,6 +15,7 @@
 use glam::Vec3;
 
 use super::MuscleUnit;
+use crate::geometry::closest_on_polyline;
 use crate::lattice::MuscleLattice;
 
 /// Pairs are kept for chain points within this distance (m) of touching a neighbour at
@@ -57,32 +58,6 @@ struct Pair {
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ChainContact {
     pairs: Vec<Pair>,
-}
-
-/// Closest point to `p` on the belly segments (`tendon` false) among `lo..hi` of
-/// polyline `x`: (segment, fraction, point); None if there is none.
-fn closest_on(
-    x: &[Vec3],
-    tendon: &[bool],
-    lo: usize,
-    hi: usize,
-    p: Vec3,
-) -> Option<(usize, f32, Vec3)> {
-    let mut best = (lo, 0.0, x[lo], f32::INFINITY);
-    for s in lo..hi {
-        if tendon[s] {
-            continue;
-        }
-        let (a, b) = (x[s], x[s + 1]);
-        let ab = b - a;
-        let t = ((p - a).dot(ab) / ab.length_squared().max(1e-12)).clamp(0.0, 1.0);
-        let q = a + ab * t;
-        let d = q.distance_squared(p);
-        if d < best.3 {
-            best = (s, t, q, d);
-        }
-    }
-    best.3.is_finite().then_some((best.0, best.1, best.2))
 }
 
 /// Radius (m) of each chain point of a muscle: the mean radius of its nearest ring.
@@ -141,7 +116,8 @@ impl ChainContact {
                     if b == a || nb < 2 {
                         continue;
                     }
-                    let Some((seg, t, q)) = closest_on(&mb.chain.x, &mb.chain.tendon, 0, nb - 1, p)
+                    let Some((seg, t, q)) =
+                        closest_on_polyline(&mb.chain.x, 0..nb - 1, |s| !mb.chain.tendon[s], p)
                     else {
                         continue;
                     };
@@ -194,7 +170,8 @@ impl ChainContact {
                 let lo = (pair.seg as usize).saturating_sub(SEGMENT_WINDOW);
                 let hi = (pair.seg as usize + SEGMENT_WINDOW + 1).min(nb - 1);
                 let p = ca.x[i];
-                let Some((s, t, q)) = closest_on(&cb.x, &cb.tendon, lo, hi, p) else {
+                let Some((s, t, q)) = closest_on_polyline(&cb.x, lo..hi, |s| !cb.tendon[s], p)
+                else {
                     continue;
                 };
                 let gap = pair.gap * 0.5 * (bulge[a] + bulge[b]);

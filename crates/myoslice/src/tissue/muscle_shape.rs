@@ -11,6 +11,7 @@ use super::bone_keep_out::{BoneKeepOut, Bones};
 use super::knee_fold::{Contact, KneeFold};
 use super::muscle_contact::{RingOutline, RingPose};
 use crate::body::BodyId;
+use crate::geometry::closest_on_polyline;
 use crate::lattice::{MuscleLattice, signed_volume};
 use crate::muscle::MuscleChain;
 
@@ -84,24 +85,6 @@ fn tube_of_ring(mesh: &crate::lattice::TubeMesh) -> Vec<(u32, u32)> {
     out
 }
 
-/// Closest point to `q` on the segments of polyline `p` that `allowed` admits.
-fn closest_on_polyline(p: &[Vec3], allowed: &[bool], q: Vec3) -> (u32, f32) {
-    let mut best = (0u32, 0.0f32, f32::INFINITY);
-    for i in 0..p.len().saturating_sub(1) {
-        if !allowed[i] {
-            continue;
-        }
-        let (a, b) = (p[i], p[i + 1]);
-        let ab = b - a;
-        let t = ((q - a).dot(ab) / ab.length_squared().max(1e-12)).clamp(0.0, 1.0);
-        let d = (a + ab * t).distance_squared(q);
-        if d < best.2 {
-            best = (i as u32, t, d);
-        }
-    }
-    (best.0, best.1)
-}
-
 impl MuscleShape {
     /// Binds a muscle lattice to its chain at rest.
     pub fn new(lattice: &MuscleLattice, chain: &MuscleChain) -> Self {
@@ -121,11 +104,12 @@ impl MuscleShape {
                 ring_of[v as usize] = ri as u32;
             }
             ring_of[r.centre as usize] = ri as u32;
-            ring_param.push(closest_on_polyline(
-                &rest_chain,
-                &belly,
-                mesh.vertices[r.centre as usize],
-            ));
+            let centre = mesh.vertices[r.centre as usize];
+            let segments = 0..rest_chain.len().saturating_sub(1);
+            ring_param.push(
+                closest_on_polyline(&rest_chain, segments, |s| belly[s], centre)
+                    .map_or((0, 0.0), |(s, t, _)| (s as u32, t)),
+            );
         }
         let mut axial = Vec::with_capacity(mesh.vertices.len());
         let mut perp = Vec::with_capacity(mesh.vertices.len());
