@@ -163,21 +163,19 @@ impl MuscleShape {
     /// shifted by `shift` across its axis (none if empty).
     fn carry_poses(&mut self, q: Quat, t: Vec3, shift: &[Vec3]) {
         let m = Mat3::from_quat(q);
-        let poses: Vec<RingPose> = self
-            .rest_points()
-            .enumerate()
-            .map(|(r, (c, u0))| {
-                let axis = q * u0;
-                let sh = shift.get(r).copied().unwrap_or_default();
-                RingPose {
-                    c: m * c + t + (sh - axis * sh.dot(axis)),
-                    m,
-                    across: 1.0,
-                    axis,
-                }
-            })
-            .collect();
-        self.pose = poses;
+        let mut pose = std::mem::take(&mut self.pose);
+        pose.clear();
+        pose.extend(self.rest_points().enumerate().map(|(r, (c, u0))| {
+            let axis = q * u0;
+            let sh = shift.get(r).copied().unwrap_or_default();
+            RingPose {
+                c: m * c + t + (sh - axis * sh.dot(axis)),
+                m,
+                across: 1.0,
+                axis,
+            }
+        }));
+        self.pose = pose;
     }
 
     /// The ring vertex `v` belongs to.
