@@ -91,6 +91,7 @@ class Simulation:
         chain_tether_release_n: float | None = None,
         chain_contact: bool | None = None,
         muscle_contact: bool | None = None,
+        fat_constraints: bool | None = None,
         voxel_mm: float | None = None,
     ) -> Simulation:
         """The built-in lower-limb phantom (no files needed).
@@ -108,7 +109,10 @@ class Simulation:
         the default, 20). ``chain_contact`` keeps muscles' chains off one another
         (``None``: the default, on); ``muscle_contact`` pushes overlapping muscle shapes
         apart after each tissue update places them, keeping their volumes (``None``: the
-        default, off: it roughly doubles the tissue's time).
+        default, off: it roughly doubles the tissue's time). ``fat_constraints`` holds
+        each fat element's volume and keeps its corners from folding inside the tissue's
+        iterations (``None``: the default, on; off: the passes one after another, which
+        fold hundreds of fat elements at deep flexion).
         """
 
     @staticmethod
@@ -133,6 +137,7 @@ class Simulation:
         chain_tether_release_n: float | None = None,
         chain_contact: bool | None = None,
         muscle_contact: bool | None = None,
+        fat_constraints: bool | None = None,
     ) -> Simulation:
         """A model from a label volume (NIfTI-1/-2 or NRRD; an oblique or reordered scan is
         brought into the body frame) or a PNG stack (its folder or manifest), told apart

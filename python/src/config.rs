@@ -26,6 +26,8 @@ pub(crate) struct ConfigArgs<'a> {
     pub(crate) chain_contact: Option<bool>,
     /// None: the core's default.
     pub(crate) muscle_contact: Option<bool>,
+    /// None: the core's default.
+    pub(crate) fat_constraints: Option<bool>,
 }
 
 impl ConfigArgs<'_> {
@@ -52,6 +54,9 @@ impl ConfigArgs<'_> {
         c.tissue.rate_hz = self.tissue_rate_hz;
         if let Some(on) = self.muscle_contact {
             c.tissue.muscle_contact = on;
+        }
+        if let Some(on) = self.fat_constraints {
+            c.tissue.fat_constraints = on;
         }
         if let Some(n) = self.tissue_iterations {
             c.tissue.iterations = usize::try_from(n).map_err(|_| {

@@ -56,7 +56,7 @@ struct PySimulation {
 impl PySimulation {
     /// The built-in lower-limb phantom (no files needed). Units are SI.
     #[staticmethod]
-    #[pyo3(signature = (*, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, tissue_iterations = None, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, chain_tether_release_n = None, chain_contact = None, muscle_contact = None, voxel_mm = None))]
+    #[pyo3(signature = (*, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, tissue_iterations = None, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, chain_tether_release_n = None, chain_contact = None, muscle_contact = None, fat_constraints = None, voxel_mm = None))]
     #[allow(clippy::too_many_arguments)]
     fn phantom(
         py: Python<'_>,
@@ -73,6 +73,7 @@ impl PySimulation {
         chain_tether_release_n: Option<f64>,
         chain_contact: Option<bool>,
         muscle_contact: Option<bool>,
+        fat_constraints: Option<bool>,
         voxel_mm: Option<f64>,
     ) -> PyResult<Self> {
         let c = ConfigArgs {
@@ -89,6 +90,7 @@ impl PySimulation {
             chain_tether_release_n,
             chain_contact,
             muscle_contact,
+            fat_constraints,
         }
         .config(py)?;
         let sim = crate::pool::detach(py, move || -> myoslice::Result<Simulation> {
@@ -110,7 +112,7 @@ impl PySimulation {
     /// "fat" or "ignore") says what to do with a name none is known by; `names` is the
     /// user's own names file (TOML).
     #[staticmethod]
-    #[pyo3(signature = (volume, labels = None, *, unmapped = "error", names = None, slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, tissue_iterations = None, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, chain_tether_release_n = None, chain_contact = None, muscle_contact = None))]
+    #[pyo3(signature = (volume, labels = None, *, unmapped = "error", names = None, slice_step = 5, rays = 48, body_mass_kg = 60.0, height_m = 1.65, muscle_model = "hill", tendon = "rigid", tissue = true, tissue_rate_hz = 30.0, tissue_iterations = None, initial_knee_deg = 0.0, max_step_s = 0.001, chain_tether = None, chain_tether_release_n = None, chain_contact = None, muscle_contact = None, fat_constraints = None))]
     #[allow(clippy::too_many_arguments)]
     fn from_nifti(
         py: Python<'_>,
@@ -133,6 +135,7 @@ impl PySimulation {
         chain_tether_release_n: Option<f64>,
         chain_contact: Option<bool>,
         muscle_contact: Option<bool>,
+        fat_constraints: Option<bool>,
     ) -> PyResult<Self> {
         let mapping = sources::mapping(py, unmapped, names.as_deref())?;
         let c = ConfigArgs {
@@ -149,6 +152,7 @@ impl PySimulation {
             chain_tether_release_n,
             chain_contact,
             muscle_contact,
+            fat_constraints,
         }
         .config(py)?;
         let build = BuildOptions {

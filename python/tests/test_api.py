@@ -297,6 +297,17 @@ def test_muscle_contact_presses_fewer_muscle_vertices_into_their_neighbours() ->
     assert found[1] < found[0], found
 
 
+def test_fat_constraints_leave_fewer_fat_elements_folded() -> None:
+    found = []
+    for on in (False, True):
+        sim = Simulation.phantom(fat_constraints=on)
+        flex(sim, 0.3)
+        a = sim.audit()
+        assert a is not None
+        found.append(a["folded_fat"])
+    assert 4 * found[1] < found[0], found
+
+
 def test_bones_outside_skin_per_bone(tissue: Simulation, rigid: Simulation) -> None:
     r = tissue.bones_outside_skin()
     assert set(r) == {"vertices_over_1mm", "farthest_m"}

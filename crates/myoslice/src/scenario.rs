@@ -28,6 +28,7 @@
 //! [tissue]                    # every TissueConfig field, all optional
 //! rate_hz = 30.0
 //! muscle_contact = false      # push overlapping muscle shapes apart (default false: slow)
+//! fat_constraints = true      # fat holds its volume and unfolds inside its iterations
 //!
 //! [excitation]                # per muscle or group: [[time s, value], ...]
 //! hamstrings = [[0.0, 0.0], [0.2, 0.6]]

@@ -7,7 +7,7 @@ use glam::Vec3;
 
 /// For each VTK hexahedron corner: the corner and its three edge neighbours in
 /// right-handed order.
-const CORNERS: [[usize; 4]; 8] = [
+pub(crate) const HEX_CORNERS: [[usize; 4]; 8] = [
     [0, 1, 3, 4],
     [1, 2, 0, 5],
     [2, 3, 1, 6],
@@ -23,7 +23,7 @@ const CORNERS: [[usize; 4]; 8] = [
 #[inline]
 pub fn corner_jacobians(x: &[Vec3], h: &[u32; 8]) -> [f32; 8] {
     let p = h.map(|i| x[i as usize]);
-    CORNERS.map(|c| {
+    HEX_CORNERS.map(|c| {
         let o = p[c[0]];
         (p[c[1]] - o).dot((p[c[2]] - o).cross(p[c[3]] - o))
     })

@@ -59,6 +59,11 @@ pub(crate) struct Guard {
 }
 
 impl Guard {
+    /// Whether the last run moved vertex `v` off the relaxed shape.
+    pub(crate) fn moved(&self, v: usize) -> bool {
+        self.share.get(v).is_some_and(|&s| s < 1.0)
+    }
+
     /// Runs the guard on `fat` (relaxed), falling back toward `safe`; `triangles` are
     /// the guarded body-surface triangles, `surface` whether to check them. Elements may
     /// not shrink to half of `eps` × their rest volume (or half their fold volume, if

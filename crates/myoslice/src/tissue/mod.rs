@@ -12,6 +12,7 @@ mod fat_keep_out;
 mod fat_lanes;
 mod fat_on_muscle;
 pub mod fat_solver;
+mod fat_volume;
 mod guard;
 mod guard_tally;
 mod incidence;
@@ -25,6 +26,7 @@ pub mod muscle_shape;
 mod phases;
 pub mod polar;
 mod reach;
+mod relax;
 mod skin_breach;
 mod skin_cover;
 #[cfg(test)]
@@ -134,6 +136,8 @@ struct TissueStatic {
     outer_faces: Vec<(u32, [u32; 4], f64)>,
     /// The skin closed at both ends (for [`Tissue::muscles_outside_skin`]).
     skin: ClosedSkin,
+    /// The fat's volume and validity constraints.
+    fat_volume: fat_volume::FatVolume,
 }
 
 /// What the front half of an update hands its back half (see [`Tissue::update_front`]).
@@ -163,6 +167,7 @@ struct Scratch {
     /// ([`crease::skin_limits`]).
     skin_limits: Vec<(f32, f32)>,
     guard: Guard,
+    volume: fat_volume::VolumeBuffers,
 }
 
 impl Clone for Scratch {
@@ -329,6 +334,7 @@ impl Tissue {
             bone_sdfs,
             outer_faces,
             skin: ClosedSkin::new(fat),
+            fat_volume: fat_volume::FatVolume::new(&fat.vertices, &fat.hexes),
         };
         let tissue = Self {
             config,
@@ -536,36 +542,17 @@ impl Tissue {
         // is whole.
         let opened = (theta / CONTACT_OPENS_RAD).clamp(0.0, 1.0);
         self.apply_contact(&contact, gap, limits, opened);
-        let k = self.config.stiffness as f32;
-        for _ in 0..self.config.iterations {
-            self.fat.iterate(k);
-            fat_on_muscle::pull(&mut self.fat.x, targets);
-            self.apply_contact(&contact, gap, limits, opened);
-        }
-        phases.shape_matching_s = lap.lap();
-        let pose = |b: BodyId| match b {
-            BodyId::Thigh => frames.thigh,
-            BodyId::Shank => frames.shank,
+        let constraints = relax::Constraints {
+            contact: &contact,
+            gap,
+            targets,
+            limits,
+            opened,
+            frames,
         };
-        fixed.bone_slide.apply(
-            &mut self.fat.x,
-            &self.fat.free,
-            &fixed.bone_sdfs,
-            &fixed.bones,
-            pose,
-        );
-        // The skin in front of the knee lifts over bone the fold brings under it.
-        fixed.fat_keep_out.apply(
-            &mut self.fat.x,
-            &self.fat.free,
-            &fixed.bone_sdfs,
-            &fixed.bones,
-            pose,
-        );
-        self.apply_contact(&contact, gap, &sc.skin_limits, opened);
+        self.relax(&constraints, &mut sc.volume, (&mut phases, &mut lap));
         self.theta = theta;
         self.scratch = sc;
-        phases.bone_sliding_s = lap.lap();
         Front {
             phases,
             shapes_finite,

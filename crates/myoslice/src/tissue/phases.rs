@@ -24,7 +24,9 @@ pub struct TissuePhases {
     /// The momentum carried into the guess, the restriction to the region that moves,
     /// and the shape-matching iterations with their muscle and contact constraints.
     pub shape_matching_s: f64,
-    /// Fat sliding on bone, and the fat in front of the knee kept off bone.
+    /// Fat sliding on bone, and the fat in front of the knee kept off bone; with the
+    /// fat's own constraints (`TissueConfig::fat_constraints`), which move those into the
+    /// iterations, the unfolding that ends the update.
     pub bone_sliding_s: f64,
     /// The validity guard (element volumes, body-surface crossings) and the momentum
     /// carried to the next update.

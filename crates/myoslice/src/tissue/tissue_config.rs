@@ -36,6 +36,10 @@ pub struct TissueConfig {
     /// doubles an update's time, and finds only part of the overlap the tissue audit
     /// counts (a muscle's rings, read as outlines, miss some of it).
     pub muscle_contact: bool,
+    /// Hold each fat element's volume and keep its corners from folding inside the
+    /// relaxation, with the bone passes in the same iterations (see
+    /// `tissue::relax`). Default true; false gives the passes run one after another.
+    pub fat_constraints: bool,
 }
 
 impl Default for TissueConfig {
@@ -50,6 +54,7 @@ impl Default for TissueConfig {
             min_volume_ratio: 0.05,
             surface_guard: true,
             muscle_contact: false,
+            fat_constraints: true,
         }
     }
 }

@@ -71,13 +71,19 @@ impl Tissue {
         let fixed = Arc::clone(&self.fixed);
         let mut sc = std::mem::take(&mut self.scratch);
         let (safe, guess) = (&sc.safe, &sc.guess);
-        let guarded = sc.guard.run(
-            &mut self.fat,
-            safe,
-            &fixed.guard_triangles,
+        let (eps, surface) = (
             self.config.min_volume_ratio as f32,
             self.config.surface_guard,
         );
+        let mut guarded = sc
+            .guard
+            .run(&mut self.fat, safe, &fixed.guard_triangles, eps, surface);
+        if guarded > 0 && self.config.fat_constraints {
+            self.unfold_after_guard(&sc.guard, &mut sc.volume);
+            guarded += sc
+                .guard
+                .run(&mut self.fat, safe, &fixed.guard_triangles, eps, surface);
+        }
         for i in 0..self.drift.len() {
             self.drift[i] = self.fat.x[i] - guess[i];
         }

@@ -1,0 +1,121 @@
+//! The fat's relaxation: shape-matching iterations with the constraints acting in them.
+//!
+//! With the fat's own constraints on ([`super::TissueConfig::fat_constraints`]), each
+//! iteration runs, one after the other on the same positions: shape matching, the pull
+//! of the inner fat toward its muscles and the contact behind the knee, and in the last
+//! iterations the sliding on bone, the skin's keep-out from bone, and the fat's volume
+//! and corners ([`super::fat_volume`]); the update ends with the unfolding swept until
+//! it gains nothing more, so the last word is the fat's validity. Without them, as before: shape matching with the pull
+//! and the contact, then the bone passes and the contact once each after the iterations
+//! (they folded hundreds of fat elements at deep flexion, docs/tissue-history.md).
+
+use std::sync::Arc;
+
+use glam::Vec3;
+
+use super::fat_volume::VolumeBuffers;
+use super::guard::Guard;
+use super::phases::Lap;
+use super::{Contact, Tissue, TissuePhases, fat_on_muscle};
+use crate::body::BodyId;
+use crate::muscle::BodyFrames;
+
+/// No corner Jacobian of a fat element may fall below this share of its rest value.
+/// A margin above ParaView's zero, so that the next update's first guess starts from
+/// elements that are not on the edge of folding.
+const CORNER_FLOOR: f32 = 0.2;
+
+/// The last iterations of an update in which the bones and the fat's own constraints act
+/// (in all six, the update took twice as long for the same audit).
+const HELD_ITERATIONS: usize = 3;
+
+/// Most sweeps of the unfolding that ends an update (it stops earlier once no element
+/// is folded, or once four sweeps have unfolded none).
+const FINAL_UNFOLD_SWEEPS: usize = 60;
+
+/// What the fat is held to during an update, besides its own shape.
+pub(super) struct Constraints<'a> {
+    /// The contact behind the knee, its gap (m), and how far it has opened (0 to 1).
+    pub contact: &'a Contact,
+    pub gap: f32,
+    pub opened: f32,
+    /// Where inner vertices facing a muscle are pulled (see [`fat_on_muscle::targets`]).
+    pub targets: &'a [(u32, Vec3, Vec3)],
+    /// The skin's limits behind the knee (see [`super::crease::skin_limits`]).
+    pub limits: &'a [(f32, f32)],
+    /// Where the bones are.
+    pub frames: &'a BodyFrames,
+}
+
+impl Tissue {
+    /// Relaxes the fat from its first guess under `c`; times the iterations and what
+    /// follows them into `phases`.
+    pub(super) fn relax(
+        &mut self,
+        c: &Constraints<'_>,
+        buffers: &mut VolumeBuffers,
+        (phases, lap): (&mut TissuePhases, &mut Lap),
+    ) {
+        let fixed = Arc::clone(&self.fixed);
+        let frames = c.frames;
+        let pose = |b: BodyId| match b {
+            BodyId::Thigh => frames.thigh,
+            BodyId::Shank => frames.shank,
+        };
+        let k = self.config.stiffness as f32;
+        let hold = self.config.fat_constraints;
+        let bones = |fat: &mut super::FatSolver| {
+            fixed
+                .bone_slide
+                .apply(&mut fat.x, &fat.free, &fixed.bone_sdfs, &fixed.bones, pose);
+            // The skin in front of the knee lifts over bone the fold brings under it.
+            fixed
+                .fat_keep_out
+                .apply(&mut fat.x, &fat.free, &fixed.bone_sdfs, &fixed.bones, pose);
+        };
+        for it in 0..self.config.iterations {
+            self.fat.iterate(k);
+            fat_on_muscle::pull(&mut self.fat.x, c.targets);
+            self.apply_contact(c.contact, c.gap, c.limits, c.opened);
+            if hold && it + HELD_ITERATIONS >= self.config.iterations {
+                bones(&mut self.fat);
+                fixed
+                    .fat_volume
+                    .hold(&mut self.fat, buffers, 1.0, CORNER_FLOOR);
+            }
+        }
+        phases.shape_matching_s += lap.lap();
+        if hold {
+            fixed
+                .fat_volume
+                .unfold(&mut self.fat, buffers, CORNER_FLOOR, FINAL_UNFOLD_SWEEPS);
+            // The skin in front of the knee, lifted over bone, has the last word there: the
+            // unfolding drew it back down onto the patella by a millimetre or two.
+            fixed.fat_keep_out.apply(
+                &mut self.fat.x,
+                &self.fat.free,
+                &fixed.bone_sdfs,
+                &fixed.bones,
+                pose,
+            );
+        } else {
+            bones(&mut self.fat);
+            self.apply_contact(c.contact, c.gap, c.limits, c.opened);
+        }
+        phases.bone_sliding_s = lap.lap();
+    }
+
+    /// After the guard fell back toward the knee fold (which has elements folded behind a
+    /// deeply bent knee), unfolds what that folded, holding the vertices the guard moved
+    /// where it put them. The caller runs the guard again on the result.
+    pub(super) fn unfold_after_guard(&mut self, guard: &Guard, buffers: &mut VolumeBuffers) {
+        let free = self.fat.free.clone();
+        for (v, f) in self.fat.free.iter_mut().enumerate() {
+            *f = *f && !guard.moved(v);
+        }
+        self.fixed
+            .fat_volume
+            .unfold(&mut self.fat, buffers, CORNER_FLOOR, FINAL_UNFOLD_SWEEPS);
+        self.fat.free = free;
+    }
+}
