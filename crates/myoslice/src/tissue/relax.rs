@@ -2,9 +2,9 @@
 //!
 //! With the fat's own constraints on ([`super::TissueConfig::fat_constraints`]), each
 //! iteration runs, one after the other on the same positions: shape matching, the pull
-//! of the inner fat toward its muscles and the contact behind the knee, and in the last
-//! iterations the sliding on bone, the skin's keep-out from bone, and the fat's volume
-//! and corners ([`super::fat_volume`]); the update ends with the unfolding swept until
+//! of the inner fat toward its muscles and the contact behind the knee; in the last
+//! iteration the sliding on bone; and in the last three the skin's keep-out from bone and
+//! the fat's volume and corners ([`super::fat_volume`]); the update ends with the unfolding swept until
 //! it gains nothing more, so the last word is the fat's validity. Without them, as before: shape matching with the pull
 //! and the contact, then the bone passes and the contact once each after the iterations
 //! (they folded hundreds of fat elements at deep flexion, docs/tissue-history.md).
@@ -25,8 +25,10 @@ use crate::muscle::BodyFrames;
 /// elements that are not on the edge of folding.
 const CORNER_FLOOR: f32 = 0.2;
 
-/// The last iterations of an update in which the bones and the fat's own constraints act
-/// (in all six, the update took twice as long for the same audit).
+/// The last iterations of an update in which the fat's own constraints and the skin's
+/// keep-out from bone act (in all six, the update took twice as long for the same
+/// audit). The sliding on bone runs in the last one only: run in each of the three, it
+/// let more bone out through the skin at deep flexion (docs/tissue-history.md).
 const HELD_ITERATIONS: usize = 3;
 
 /// Most sweeps of the unfolding that ends an update (it stops earlier once no element
@@ -77,8 +79,23 @@ impl Tissue {
             self.fat.iterate(k);
             fat_on_muscle::pull(&mut self.fat.x, c.targets);
             self.apply_contact(c.contact, c.gap, c.limits, c.opened);
+            if hold && it + 1 == self.config.iterations {
+                fixed.bone_slide.apply(
+                    &mut self.fat.x,
+                    &self.fat.free,
+                    &fixed.bone_sdfs,
+                    &fixed.bones,
+                    pose,
+                );
+            }
             if hold && it + HELD_ITERATIONS >= self.config.iterations {
-                bones(&mut self.fat);
+                fixed.fat_keep_out.apply(
+                    &mut self.fat.x,
+                    &self.fat.free,
+                    &fixed.bone_sdfs,
+                    &fixed.bones,
+                    pose,
+                );
                 fixed
                     .fat_volume
                     .hold(&mut self.fat, buffers, 1.0, CORNER_FLOOR);
