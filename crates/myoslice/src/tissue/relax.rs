@@ -16,7 +16,7 @@ use glam::Vec3;
 use super::fat_volume::VolumeBuffers;
 use super::guard::Guard;
 use super::phases::Lap;
-use super::{Contact, Tissue, TissuePhases, fat_on_muscle};
+use super::{Contact, FatSolver, Tissue, TissuePhases, fat_on_muscle};
 use crate::body::BodyId;
 use crate::muscle::BodyFrames;
 
@@ -66,11 +66,13 @@ impl Tissue {
         };
         let k = self.config.stiffness as f32;
         let hold = self.config.fat_constraints;
-        let bones = |fat: &mut super::FatSolver| {
+        let slide = |fat: &mut FatSolver| {
             fixed
                 .bone_slide
                 .apply(&mut fat.x, &fat.free, &fixed.bone_sdfs, &fixed.bones, pose);
-            // The skin in front of the knee lifts over bone the fold brings under it.
+        };
+        // The skin in front of the knee lifts over bone the fold brings under it.
+        let keep_out = |fat: &mut FatSolver| {
             fixed
                 .fat_keep_out
                 .apply(&mut fat.x, &fat.free, &fixed.bone_sdfs, &fixed.bones, pose);
@@ -80,22 +82,10 @@ impl Tissue {
             fat_on_muscle::pull(&mut self.fat.x, c.targets);
             self.apply_contact(c.contact, c.gap, c.limits, c.opened);
             if hold && it + 1 == self.config.iterations {
-                fixed.bone_slide.apply(
-                    &mut self.fat.x,
-                    &self.fat.free,
-                    &fixed.bone_sdfs,
-                    &fixed.bones,
-                    pose,
-                );
+                slide(&mut self.fat);
             }
             if hold && it + HELD_ITERATIONS >= self.config.iterations {
-                fixed.fat_keep_out.apply(
-                    &mut self.fat.x,
-                    &self.fat.free,
-                    &fixed.bone_sdfs,
-                    &fixed.bones,
-                    pose,
-                );
+                keep_out(&mut self.fat);
                 fixed
                     .fat_volume
                     .hold(&mut self.fat, buffers, 1.0, CORNER_FLOOR);
@@ -106,17 +96,12 @@ impl Tissue {
             fixed
                 .fat_volume
                 .unfold(&mut self.fat, buffers, CORNER_FLOOR, FINAL_UNFOLD_SWEEPS);
-            // The skin in front of the knee, lifted over bone, has the last word there: the
-            // unfolding drew it back down onto the patella by a millimetre or two.
-            fixed.fat_keep_out.apply(
-                &mut self.fat.x,
-                &self.fat.free,
-                &fixed.bone_sdfs,
-                &fixed.bones,
-                pose,
-            );
+            // The skin's keep-out has the last word in front of the knee: the unfolding
+            // drew it back down onto the patella by a millimetre or two.
+            keep_out(&mut self.fat);
         } else {
-            bones(&mut self.fat);
+            slide(&mut self.fat);
+            keep_out(&mut self.fat);
             self.apply_contact(c.contact, c.gap, c.limits, c.opened);
         }
         phases.bone_sliding_s = lap.lap();
