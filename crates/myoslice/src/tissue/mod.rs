@@ -1,6 +1,7 @@
 //! Tissue deformation: constant-volume muscles riding on their chains, shape-matching fat
-//! that follows muscles and bones, the knee fold and contact plane behind the knee, a
-//! validity guard, and the per-element metrics of the paper (section 5.3).
+//! that follows muscles and bones while holding its volume and unfolding (`relax`,
+//! `fat_volume`), the knee fold and contact plane behind the knee, a validity guard, and
+//! the per-element metrics of the paper (section 5.3).
 
 mod audit;
 mod bone_keep_out;
