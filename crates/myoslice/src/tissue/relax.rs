@@ -4,9 +4,10 @@
 //! iteration runs, one after the other on the same positions: shape matching, the pull
 //! of the inner fat toward its muscles and the contact behind the knee; in the last
 //! iteration the sliding on bone; and in the last three the skin's keep-out from bone and
-//! the fat's volume and corners ([`super::fat_volume`]); the update ends with the unfolding swept until
-//! it gains nothing more, so the last word is the fat's validity. Without them, as before: shape matching with the pull
-//! and the contact, then the bone passes and the contact once each after the iterations
+//! the fat's volume and corners ([`super::fat_volume`]). The update ends with the
+//! unfolding swept until it gains nothing more, so the last word is the fat's validity.
+//! Without them, as before: shape matching with the pull and the contact, then the bone
+//! passes and the contact once each after the iterations
 //! (they folded hundreds of fat elements at deep flexion, docs/tissue-history.md).
 
 use std::sync::Arc;
