@@ -18,15 +18,19 @@ pub(crate) const HEX_CORNERS: [[usize; 4]; 8] = [
     [7, 6, 4, 3],
 ];
 
+/// The Jacobian at corner `c` (one of [`HEX_CORNERS`]) of the hexahedron with corners `p`.
+#[inline]
+pub(crate) fn corner_jacobian(p: &[Vec3; 8], c: [usize; 4]) -> f32 {
+    let o = p[c[0]];
+    (p[c[1]] - o).dot((p[c[2]] - o).cross(p[c[3]] - o))
+}
+
 /// The eight corner Jacobians of hexahedron `h` of `x` (VTK corner order; m³: six times
 /// each corner tetrahedron's volume).
 #[inline]
 pub fn corner_jacobians(x: &[Vec3], h: &[u32; 8]) -> [f32; 8] {
     let p = h.map(|i| x[i as usize]);
-    HEX_CORNERS.map(|c| {
-        let o = p[c[0]];
-        (p[c[1]] - o).dot((p[c[2]] - o).cross(p[c[3]] - o))
-    })
+    HEX_CORNERS.map(|c| corner_jacobian(&p, c))
 }
 
 /// The smallest of a hexahedron's eight corner Jacobians.

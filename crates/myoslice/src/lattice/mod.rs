@@ -17,7 +17,7 @@ pub use builder::BuildOptions;
 pub use checks::{InvariantReport, oriented_trimesh, strictly_inside, winding_number};
 pub use fat::{FatLattice, InnerContact, hex_volume, hex_volume_f32, hex_volume_points, quad_area};
 pub use frame::SliceFrame;
-pub(crate) use hex_quality::HEX_CORNERS;
+pub(crate) use hex_quality::{HEX_CORNERS, corner_jacobian};
 pub use hex_quality::{corner_jacobians, hex_is_valid, min_corner_jacobian};
 pub use tube::{Ring, RingInput, Slab, TubeMesh, check_closed, signed_volume};
 

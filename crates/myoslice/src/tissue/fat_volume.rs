@@ -13,12 +13,8 @@
 use glam::Vec3;
 
 use super::fat_solver::FatSolver;
-use crate::lattice::{HEX_CORNERS, corner_jacobians};
+use crate::lattice::{HEX_CORNERS, corner_jacobian, corner_jacobians};
 use crate::par::*;
-
-/// VTK hexahedron corners and their three edge neighbours, right-handed (as
-/// [`corner_jacobians`]).
-const CORNERS: [[usize; 4]; 8] = HEX_CORNERS;
 
 /// An element's volume is held only when it is further than this share off its rest
 /// volume: most of the relaxed region moves nearly rigidly.
@@ -54,13 +50,6 @@ pub(crate) struct VolumeBuffers {
     new_x: Vec<Vec3>,
 }
 
-/// The corner Jacobian of corner `c` of `p`.
-#[inline]
-fn jacobian(p: &[Vec3; 8], c: [usize; 4]) -> f32 {
-    let o = p[c[0]];
-    (p[c[1]] - o).dot((p[c[2]] - o).cross(p[c[3]] - o))
-}
-
 /// The gradient of corner `c`'s Jacobian with respect to the four points it involves.
 #[inline]
 fn gradient(p: &[Vec3; 8], c: [usize; 4]) -> [(usize, Vec3); 4] {
@@ -87,8 +76,8 @@ fn step_along(p: &mut [Vec3; 8], w: &[f32; 8], g: &[(usize, Vec3)], change: f32)
 /// corner after the other.
 #[inline]
 fn raise_corners(p: &mut [Vec3; 8], w: &[f32; 8], rest: &[f32; 8], floor: f32) {
-    for (c, r) in CORNERS.iter().zip(rest) {
-        let (min, j) = (floor * r, jacobian(p, *c));
+    for (c, r) in HEX_CORNERS.iter().zip(rest) {
+        let (min, j) = (floor * r, corner_jacobian(p, *c));
         if j < min {
             let g = gradient(p, *c);
             step_along(p, w, &g, min - j);
@@ -107,10 +96,12 @@ impl FatVolume {
         }
     }
 
-    /// Whether element `e` has a corner below `floor` × its rest Jacobian.
-    fn below_at(&self, x: &[Vec3], hexes: &[[u32; 8]], e: usize, floor: f32) -> bool {
+    /// Whether element `e` has a corner below `floor` × its rest Jacobian, and whether it
+    /// has one below zero (folded).
+    fn below_at(&self, x: &[Vec3], hexes: &[[u32; 8]], e: usize, floor: f32) -> (bool, bool) {
         let c = corner_jacobians(x, &hexes[e]);
-        c.iter().zip(&self.rest[e]).any(|(j, r)| *j < floor * r)
+        let below = |f: f32| c.iter().zip(&self.rest[e]).any(|(j, r)| *j < f * r);
+        (below(floor), below(0.0))
     }
 
     /// One projection of every active element more than [`VOLUME_SLACK`] off its rest
@@ -145,8 +136,8 @@ impl FatVolume {
                 gi.0 = i;
             }
             let mut change = sum0(e);
-            for c in CORNERS {
-                change -= jacobian(p, c);
+            for c in HEX_CORNERS {
+                change -= corner_jacobian(p, c);
                 for (i, gi) in gradient(p, c) {
                     g[i].1 += gi;
                 }
@@ -172,8 +163,13 @@ impl FatVolume {
         b.elements.clear();
         b.elements
             .par_extend((0..fat.hexes.len() as u32).into_par_iter().filter(|&e| {
-                fat.active[e as usize] && self.below_at(&fat.x, &fat.hexes, e as usize, floor)
+                fat.active[e as usize] && self.below_at(&fat.x, &fat.hexes, e as usize, floor).0
             }));
+        let mut folded = b
+            .elements
+            .iter()
+            .filter(|&&e| self.below_at(&fat.x, &fat.hexes, e as usize, floor).1)
+            .count();
         if b.seen.len() != fat.x.len() {
             b.seen = vec![false; fat.x.len()];
         }
@@ -182,11 +178,6 @@ impl FatVolume {
         for r in 0..rounds {
             // Stop when no element is left folded, or when the sweeps have stopped
             // unfolding any (tissue squeezed with no room left: the guard's business).
-            let folded = b
-                .elements
-                .iter()
-                .filter(|&&e| self.below_at(&fat.x, &fat.hexes, e as usize, 0.0))
-                .count();
             let before = std::mem::replace(&mut history[r % STALLED_AFTER], folded);
             if folded == 0 || folded >= before {
                 return;
@@ -220,8 +211,12 @@ impl FatVolume {
             b.elements.sort_unstable();
             b.elements.dedup();
             let (x, hexes, active) = (&fat.x, &fat.hexes, &fat.active);
-            b.elements
-                .retain(|&e| active[e as usize] && self.below_at(x, hexes, e as usize, floor));
+            folded = 0;
+            b.elements.retain(|&e| {
+                let (below, flat) = self.below_at(x, hexes, e as usize, floor);
+                folded += usize::from(active[e as usize] && flat);
+                active[e as usize] && below
+            });
         }
     }
 
