@@ -308,6 +308,8 @@ class Simulation:
         ``muscles_out_of_skin`` and ``bones_out_of_skin``: ``{vertices_over_1mm,
         farthest_m}``, None where the skin cannot be closed; ``muscles_in_bone`` and
         ``muscles_in_muscles``: ``{vertices_over_1mm, deepest_m}``; ``skin_crossings``;
+        ``skin_in_contact_m2``: area of skin touching skin, each side counted, None where
+        the skin cannot be closed;
         ``muscle_volume_ratio``: [smallest, largest]; ``fat_off_rest_m``; ``finite``).
         None without tissue. Exact: about a second on a whole leg."""
 

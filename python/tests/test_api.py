@@ -279,6 +279,8 @@ def test_audit_sums_the_per_muscle_measures(tissue: Simulation, rigid: Simulatio
     # Folded fat is counted by corner Jacobians, as the tissue metrics count it.
     assert a["folded_fat"] >= 0 and 0.0 < a["min_fat_volume_ratio"] <= 1.0
     assert a["muscles_in_muscles"]["deepest_m"] >= 0.0
+    # Skin touching skin, in m²: some once the knee bends, far less than the whole skin.
+    assert 0.0 < a["skin_in_contact_m2"] < 0.05
     lo, hi = a["muscle_volume_ratio"]
     assert 0.0 < lo <= hi
     assert rigid.audit() is None

@@ -159,7 +159,7 @@ mod tests {
         let (time, update, a) = r.last().unwrap();
         assert_eq!((*time, *update), (0.0, 0));
         let lines = a.lines();
-        assert_eq!(lines.len(), 9);
+        assert_eq!(lines.len(), 10);
         let folded = &lines[0];
         assert_eq!(folded.found, a.folded_fat.to_string());
         assert_eq!(folded.holds, a.folded_fat == 0);

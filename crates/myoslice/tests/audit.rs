@@ -101,6 +101,31 @@ fn the_audit_finds_a_muscle_out_through_the_skin_inside_another_and_a_skin_fold(
     assert!(!t.audit(frames).finite);
 }
 
+/// The skin that touches skin, measured from the skin alone: a few triangles where the
+/// phantom's skin faces itself at the top of the thigh as built, and far more once the
+/// knee is bent deep and the calf lies against the thigh.
+#[test]
+fn skin_touches_skin_behind_a_deeply_bent_knee_and_hardly_anywhere_at_rest() {
+    let mut sim = Simulation::phantom(SimulationConfig::default()).unwrap();
+    let rest = sim.audit().unwrap().skin_in_contact_m2.unwrap();
+    assert!(rest < 5e-4, "{:.1} cm² at rest", rest * 1e4);
+    sim.set_knee(130f64.to_radians(), 0.0).unwrap();
+    sim.update_tissue().unwrap();
+    let a = sim.audit().unwrap();
+    let bent = a.skin_in_contact_m2.unwrap();
+    assert!(
+        bent > rest + 5e-4,
+        "{:.1} cm² at rest, {:.1} cm² at 130°",
+        rest * 1e4,
+        bent * 1e4
+    );
+    let line = a.lines().into_iter().find(|l| l.check == "skin in contact");
+    assert_eq!(
+        line.map(|l| l.found),
+        Some(format!("{:.1} cm²", bent * 1e4))
+    );
+}
+
 /// A short flexion with the audit on and off (every other output off).
 fn audited_run(audit: bool) -> (std::path::PathBuf, myoslice::export::RunSummary) {
     let dir = common::scratch(&format!("audit-run-{audit}"));
@@ -135,6 +160,11 @@ fn an_audited_run_writes_a_row_for_each_tissue_update() {
         .collect();
     assert_eq!(folded.iter().max(), Some(&audit.worst.folded_fat));
     assert_eq!(folded.last(), Some(&audit.last.folded_fat));
+    let contact: f32 = rows.last().unwrap()[col("skin_in_contact_cm2")]
+        .parse()
+        .unwrap();
+    let last = audit.last.skin_in_contact_m2.unwrap() * 1e4;
+    assert!((contact - last).abs() < 1e-3, "{contact} {last}");
     let json = std::fs::read_to_string(out.join("summary.json")).unwrap();
     assert!(json.contains("\"muscles_in_muscles\""), "{json}");
 

@@ -35,6 +35,10 @@ pub struct TissueAudit {
     pub muscles_in_muscles: MuscleOverlap,
     /// Pairs of skin triangles that cross.
     pub skin_crossings: usize,
+    /// Area of skin touching other skin (m²): faces with the skin across from them within
+    /// the contact gap and 1 mm, or passed into the body across from them; each side of a
+    /// contact counts its own (None when the skin cannot be closed into a mesh).
+    pub skin_in_contact_m2: Option<f32>,
     /// Smallest and largest muscle volume over its rest volume.
     pub muscle_volume_ratio: [f32; 2],
     /// Farthest fat vertex from its rest place carried by its bone (m): with the knee
@@ -117,6 +121,13 @@ impl TissueAudit {
                 (a.skin_crossings.to_string(), a.skin_crossings == 0),
             ),
             line(
+                "skin in contact",
+                match a.skin_in_contact_m2 {
+                    Some(m2) => (format!("{:.1} cm²", m2 * 1e4), true),
+                    None => ("skin not closed".to_string(), false),
+                },
+            ),
+            line(
                 "muscle volumes",
                 (
                     format!("{lo:.3}..{hi:.3}"),
@@ -153,6 +164,10 @@ impl TissueAudit {
             muscles_in_bone: self.muscles_in_bone.worse(&o.muscles_in_bone),
             muscles_in_muscles: self.muscles_in_muscles.worse(&o.muscles_in_muscles),
             skin_crossings: self.skin_crossings.max(o.skin_crossings),
+            skin_in_contact_m2: match (self.skin_in_contact_m2, o.skin_in_contact_m2) {
+                (Some(a), Some(b)) => Some(a.max(b)),
+                _ => None,
+            },
             muscle_volume_ratio: [
                 self.muscle_volume_ratio[0].min(o.muscle_volume_ratio[0]),
                 self.muscle_volume_ratio[1].max(o.muscle_volume_ratio[1]),
@@ -166,7 +181,8 @@ impl TissueAudit {
     pub const CSV_HEADER: &'static str = "folded_fat,fat_under_half_volume,min_fat_volume_ratio,\
 muscle_vertices_out_of_skin,muscle_out_of_skin_mm,bone_vertices_out_of_skin,bone_out_of_skin_mm,\
 muscle_vertices_in_bone,muscle_in_bone_mm,muscle_vertices_in_muscle,muscle_in_muscle_mm,\
-skin_crossings,min_muscle_volume_ratio,max_muscle_volume_ratio,fat_off_rest_mm,finite";
+skin_crossings,min_muscle_volume_ratio,max_muscle_volume_ratio,fat_off_rest_mm,\
+skin_in_contact_cm2,finite";
 
     /// The audit as one CSV row (an empty cell where the skin could not be closed).
     pub fn csv_row(&self) -> String {
@@ -177,7 +193,7 @@ skin_crossings,min_muscle_volume_ratio,max_muscle_volume_ratio,fat_off_rest_mm,f
             )
         };
         format!(
-            "{},{},{:.5},{},{},{},{:.3},{},{:.3},{},{:.5},{:.5},{:.3},{}",
+            "{},{},{:.5},{},{},{},{:.3},{},{:.3},{},{:.5},{:.5},{:.3},{},{}",
             self.folded_fat,
             self.fat_under_half_volume,
             self.min_fat_volume_ratio,
@@ -191,6 +207,8 @@ skin_crossings,min_muscle_volume_ratio,max_muscle_volume_ratio,fat_off_rest_mm,f
             self.muscle_volume_ratio[0],
             self.muscle_volume_ratio[1],
             self.fat_off_rest_m * 1e3,
+            self.skin_in_contact_m2
+                .map_or_else(String::new, |m2| format!("{:.3}", m2 * 1e4)),
             self.finite,
         )
     }
@@ -199,8 +217,8 @@ skin_crossings,min_muscle_volume_ratio,max_muscle_volume_ratio,fat_off_rest_mm,f
 impl Tissue {
     /// Every soundness check of the tissue now, with the bones at `frames`: folded and
     /// squashed fat, muscles and bones out through the skin, muscles in bone and in one
-    /// another, the skin crossing itself, muscle volumes, and how far the fat is from its
-    /// rest place. Exact (see the module); a second or so on a whole leg.
+    /// another, the skin crossing itself and touching itself, muscle volumes, and how far
+    /// the fat is from its rest place. Exact (see the module); a second or so on a whole leg.
     pub fn audit(&self, frames: &BodyFrames) -> TissueAudit {
         let fat = &self.fat;
         // Per element in parallel, then summed in order (the same on one thread: a web
@@ -251,6 +269,10 @@ impl Tissue {
             muscles_in_bone: Overlap::total(&self.muscles_in_bone(frames)),
             muscles_in_muscles: Overlap::total(&self.muscles_in_muscles()),
             skin_crossings: self.fixed.skin.crossings(&skin),
+            skin_in_contact_m2: mesh.as_ref().and_then(|m| {
+                let reach = self.config.contact_gap_m as f32 + 1e-3;
+                Some(self.fixed.skin.contact_area(&skin, m, reach)? as f32)
+            }),
             muscle_volume_ratio,
             fat_off_rest_m,
             finite: fat.x.iter().all(|p| p.is_finite())
