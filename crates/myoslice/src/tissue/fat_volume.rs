@@ -8,7 +8,8 @@
 //! projections: [`FatVolume::hold`] on many elements at once, each vertex moved by the
 //! mean of its elements' corrections (Jacobi, summed in element order), and
 //! [`FatVolume::unfold`] on the few elements left folded, one after the other in index
-//! order (Gauss–Seidel). Neither depends on the thread count.
+//! order (Gauss–Seidel), and [`FatVolume::untangle`] on the vertices of what that left,
+//! one after the other. None depends on the thread count.
 
 use glam::Vec3;
 
@@ -159,7 +160,7 @@ impl FatVolume {
         b: &mut VolumeBuffers,
         floor: f32,
         rounds: usize,
-    ) {
+    ) -> usize {
         b.elements.clear();
         b.elements
             .par_extend((0..fat.hexes.len() as u32).into_par_iter().filter(|&e| {
@@ -180,7 +181,7 @@ impl FatVolume {
             // unfolding any (tissue squeezed with no room left: the guard's business).
             let before = std::mem::replace(&mut history[r % STALLED_AFTER], folded);
             if folded == 0 || folded >= before {
-                return;
+                return folded;
             }
             b.vertices.clear();
             for &e in &b.elements {
@@ -201,15 +202,12 @@ impl FatVolume {
                 }
             }
             // Next sweep: the elements about the vertices just moved.
-            b.elements.clear();
             for &v in &b.vertices {
                 b.seen[v as usize] = false;
-                let (s, t) = (self.inc_start[v as usize], self.inc_start[v as usize + 1]);
-                b.elements
-                    .extend(self.inc[s as usize..t as usize].iter().map(|c| c >> 3));
             }
-            b.elements.sort_unstable();
-            b.elements.dedup();
+            let moved = std::mem::take(&mut b.vertices);
+            self.elements_about(b, &moved);
+            b.vertices = moved;
             let (x, hexes, active) = (&fat.x, &fat.hexes, &fat.active);
             folded = 0;
             b.elements.retain(|&e| {
@@ -217,6 +215,101 @@ impl FatVolume {
                 folded += usize::from(active[e as usize] && flat);
                 active[e as usize] && below
             });
+        }
+        folded
+    }
+
+    /// Untangles what [`Self::unfold`] left: each free vertex of a folded active element
+    /// (a corner Jacobian at or below zero) moves to where every corner Jacobian it takes
+    /// part in (of all its elements) reaches `floor` × its rest value, if it can: each is affine
+    /// in one vertex's position, so the vertex is projected onto their half-spaces in
+    /// turn, and keeps the result only if its worst corner rose. One vertex after the
+    /// other in index order; sweeps over the folded elements about what moved until none
+    /// is, or [`STALLED_AFTER`] sweeps unfold none, at most `sweeps`. Starts from the
+    /// folded ones among `b`'s elements: what [`Self::unfold`] left there, or those about
+    /// some vertices ([`Self::elements_about`]). Where an
+    /// element's own corners pull against its neighbours' (the unfolding's stall), a
+    /// vertex that heeds all its elements at once finds the room between them.
+    pub(crate) fn untangle(
+        &self,
+        fat: &mut FatSolver,
+        b: &mut VolumeBuffers,
+        floor: f32,
+        sweeps: usize,
+    ) {
+        let (x, hexes, active) = (&fat.x, &fat.hexes, &fat.active);
+        b.elements
+            .retain(|&e| active[e as usize] && self.below_at(x, hexes, e as usize, 0.0).1);
+        if b.seen.len() != fat.x.len() {
+            b.seen = vec![false; fat.x.len()];
+        }
+        let mut folded = b.elements.len();
+        let mut history = [usize::MAX; STALLED_AFTER];
+        let mut limits: Vec<(Vec3, f32, f32, f32)> = Vec::new();
+        for r in 0..sweeps {
+            let before = std::mem::replace(&mut history[r % STALLED_AFTER], folded);
+            if folded == 0 || folded >= before {
+                return;
+            }
+            b.vertices.clear();
+            for &e in &b.elements {
+                for &v in &fat.hexes[e as usize] {
+                    if fat.free[v as usize] && !b.seen[v as usize] {
+                        b.seen[v as usize] = true;
+                        b.vertices.push(v);
+                    }
+                }
+            }
+            b.vertices.sort_unstable();
+            for &v in &b.vertices {
+                b.seen[v as usize] = false;
+                self.corner_limits(fat, v as usize, floor, &mut limits);
+                if let Some(d) = untangle_vertex(&limits) {
+                    fat.x[v as usize] += d;
+                }
+            }
+            let moved = std::mem::take(&mut b.vertices);
+            self.elements_about(b, &moved);
+            b.vertices = moved;
+            let (x, hexes, active) = (&fat.x, &fat.hexes, &fat.active);
+            b.elements
+                .retain(|&e| active[e as usize] && self.below_at(x, hexes, e as usize, 0.0).1);
+            folded = b.elements.len();
+        }
+    }
+
+    /// Puts the elements about `vertices` in `b` (ascending, each once), where
+    /// [`Self::untangle`] starts.
+    pub(crate) fn elements_about(&self, b: &mut VolumeBuffers, vertices: &[u32]) {
+        b.elements.clear();
+        for &v in vertices {
+            let (s, t) = (self.inc_start[v as usize], self.inc_start[v as usize + 1]);
+            b.elements
+                .extend(self.inc[s as usize..t as usize].iter().map(|c| c >> 3));
+        }
+        b.elements.sort_unstable();
+        b.elements.dedup();
+    }
+
+    /// Every corner Jacobian that vertex `v` takes part in, as (its gradient with respect
+    /// to `v`, its value, its bound: `floor` × its rest value, its rest value).
+    fn corner_limits(
+        &self,
+        fat: &FatSolver,
+        v: usize,
+        floor: f32,
+        out: &mut Vec<(Vec3, f32, f32, f32)>,
+    ) {
+        out.clear();
+        let (s, t) = (self.inc_start[v] as usize, self.inc_start[v + 1] as usize);
+        for &c in &self.inc[s..t] {
+            let (e, k) = ((c >> 3) as usize, (c & 7) as usize);
+            let p = fat.hexes[e].map(|i| fat.x[i as usize]);
+            for (corner, rest) in HEX_CORNERS.iter().zip(&self.rest[e]) {
+                if let Some(&(_, g)) = gradient(&p, *corner).iter().find(|(i, _)| *i == k) {
+                    out.push((g, corner_jacobian(&p, *corner), floor * rest, *rest));
+                }
+            }
         }
     }
 
@@ -311,6 +404,47 @@ impl FatVolume {
     }
 }
 
+/// Most rounds of projecting one vertex onto the half-spaces of its corners.
+const VERTEX_ROUNDS: usize = 16;
+
+/// Farthest (m) the untangling moves a vertex in one sweep: under half an element's
+/// size. Where its corners leave no room (or nearly flat ones, with tiny gradients, ask
+/// for a long way), uncapped steps threw vertices tens of centimetres.
+const VERTEX_STEP_M: f32 = 0.002;
+
+/// Where a vertex should move (see [`FatVolume::untangle`]) given its corners' `limits`
+/// (gradient, value, bound, rest value): None when the projections do not raise its worst
+/// corner (relative to its rest value).
+fn untangle_vertex(limits: &[(Vec3, f32, f32, f32)]) -> Option<Vec3> {
+    let worst = |d: Vec3| {
+        limits
+            .iter()
+            .map(|(g, j, min, rest)| (j + g.dot(d) - min) / rest.abs().max(1e-30))
+            .fold(f32::INFINITY, f32::min)
+    };
+    let start = worst(Vec3::ZERO);
+    if start >= 0.0 {
+        return None;
+    }
+    let mut d = Vec3::ZERO;
+    for _ in 0..VERTEX_ROUNDS {
+        let mut held = true;
+        for (g, j, min, _) in limits {
+            let short = min - (j + g.dot(d));
+            let gg = g.length_squared();
+            if short > 0.0 && gg > 1e-30 {
+                d += *g * (short / gg);
+                held = false;
+            }
+        }
+        if held {
+            break;
+        }
+    }
+    let d = d.clamp_length_max(VERTEX_STEP_M);
+    (d.is_finite() && worst(d) > start).then_some(d)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -351,6 +485,41 @@ mod tests {
     }
 
     #[test]
+    fn a_vertex_pushed_through_its_neighbours_is_untangled_and_held_vertices_stay() {
+        let mut fat = FatSolver::grid(4, 3, 3, 0.01);
+        let c = FatVolume::new(&fat.rest, &fat.hexes);
+        let v = 1 + 5 * (1 + 4);
+        fat.x[v] += Vec3::new(0.015, 0.004, -0.003);
+        assert!(folded(&fat) > 0);
+        for (f, p) in fat.free.iter_mut().zip(&fat.rest) {
+            *f = p.z > 0.0;
+        }
+        let held: Vec<Vec3> = (0..fat.x.len())
+            .filter(|&u| !fat.free[u])
+            .map(|u| fat.x[u])
+            .collect();
+        let mut b = VolumeBuffers::default();
+        // Alone, without the element-by-element unfolding first: every corner ends at
+        // least 0.2 of its rest value.
+        let all: Vec<u32> = (0..fat.x.len() as u32).collect();
+        c.elements_about(&mut b, &all);
+        c.untangle(&mut fat, &mut b, 0.2, 60);
+        assert_eq!(folded(&fat), 0);
+        for h in &fat.hexes {
+            let (j, r) = (corner_jacobians(&fat.x, h), corner_jacobians(&fat.rest, h));
+            assert!(
+                j.iter().zip(&r).all(|(j, r)| *j >= 0.2 * r - 1e-12),
+                "{j:?}"
+            );
+        }
+        let now: Vec<Vec3> = (0..fat.x.len())
+            .filter(|&u| !fat.free[u])
+            .map(|u| fat.x[u])
+            .collect();
+        assert_eq!(now, held);
+    }
+
+    #[test]
     fn squashed_elements_get_their_volume_back() {
         let mut fat = FatSolver::grid(3, 3, 3, 0.01);
         let c = FatVolume::new(&fat.rest, &fat.hexes);
@@ -382,6 +551,7 @@ mod tests {
             let mut b = VolumeBuffers::default();
             c.hold(&mut fat, &mut b, 1.0, 0.2);
             c.unfold(&mut fat, &mut b, 0.2, 10);
+            c.untangle(&mut fat, &mut b, 0.2, 10);
             fat.x
         };
         let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build();

@@ -5,7 +5,8 @@
 //! of the inner fat toward its muscles and the contact behind the knee; in the last
 //! iteration the sliding on bone; and in the last three the skin's keep-out from bone and
 //! the fat's volume and corners ([`super::fat_volume`]). The update ends with the
-//! unfolding swept until it gains nothing more, so the last word is the fat's validity.
+//! unfolding swept until it gains nothing more, then the untangling of what it left
+//! (vertex by vertex), so the last word is the fat's validity.
 //! Without them, as before: shape matching with the pull and the contact, then the bone
 //! passes and the contact once each after the iterations
 //! (they folded hundreds of fat elements at deep flexion, docs/tissue-history.md).
@@ -94,12 +95,32 @@ impl Tissue {
         }
         phases.shape_matching_s += lap.lap();
         if hold {
-            fixed
-                .fat_volume
-                .unfold(&mut self.fat, buffers, CORNER_FLOOR, FINAL_UNFOLD_SWEEPS);
+            let volume = &fixed.fat_volume;
+            // What the element-by-element unfolding leaves (elements pulling against
+            // their neighbours in the squeezed inner layer) each vertex untangles heeding
+            // all its elements at once.
+            if volume.unfold(&mut self.fat, buffers, CORNER_FLOOR, FINAL_UNFOLD_SWEEPS) > 0 {
+                volume.untangle(&mut self.fat, buffers, CORNER_FLOOR, FINAL_UNFOLD_SWEEPS);
+            }
             // The skin's keep-out has the last word in front of the knee: the unfolding
-            // drew it back down onto the patella by a millimetre or two.
+            // drew it back down onto the patella by a millimetre or two. What that folds
+            // is untangled with the vertices it moved held where it put them.
+            let before = self.fat.x.clone();
             keep_out(&mut self.fat);
+            let moved: Vec<u32> = (0..before.len() as u32)
+                .filter(|&v| self.fat.x[v as usize] != before[v as usize])
+                .collect();
+            if !moved.is_empty() {
+                for &v in &moved {
+                    self.fat.free[v as usize] = false;
+                }
+                volume.elements_about(buffers, &moved);
+                volume.untangle(&mut self.fat, buffers, CORNER_FLOOR, FINAL_UNFOLD_SWEEPS);
+                // Free again: the keep-out only holds them for this untangling.
+                for &v in &moved {
+                    self.fat.free[v as usize] = true;
+                }
+            }
         } else {
             slide(&mut self.fat);
             keep_out(&mut self.fat);
@@ -116,6 +137,9 @@ impl Tissue {
         for (v, f) in self.fat.free.iter_mut().enumerate() {
             *f = *f && !guard.moved(v);
         }
+        // Not untangled here: even with the skin by the bones held where the guard left
+        // it, untangling there let bone out through the skin at deep flexion
+        // (docs/tissue-history.md).
         self.fixed
             .fat_volume
             .unfold(&mut self.fat, buffers, CORNER_FLOOR, FINAL_UNFOLD_SWEEPS);
