@@ -221,15 +221,15 @@ impl FatVolume {
 
     /// Untangles what [`Self::unfold`] left: each free vertex of a folded active element
     /// (a corner Jacobian at or below zero) moves to where every corner Jacobian it takes
-    /// part in (of all its elements) reaches `floor` × its rest value, if it can: each is affine
-    /// in one vertex's position, so the vertex is projected onto their half-spaces in
-    /// turn, and keeps the result only if its worst corner rose. One vertex after the
-    /// other in index order; sweeps over the folded elements about what moved until none
-    /// is, or [`STALLED_AFTER`] sweeps unfold none, at most `sweeps`. Starts from the
-    /// folded ones among `b`'s elements: what [`Self::unfold`] left there, or those about
-    /// some vertices ([`Self::elements_about`]). Where an
-    /// element's own corners pull against its neighbours' (the unfolding's stall), a
-    /// vertex that heeds all its elements at once finds the room between them.
+    /// part in (of all its elements) reaches `floor` × its rest value, if it can. Each is
+    /// affine in one vertex's position, so the vertex is projected onto their half-spaces
+    /// in turn, and keeps the result only if its worst corner rose. Where an element's own
+    /// corners pull against its neighbours' (the unfolding's stall), a vertex that heeds
+    /// all its elements at once finds the room between them. One vertex after the other
+    /// in index order; sweeps over the folded elements about what moved until none is, or
+    /// [`STALLED_AFTER`] sweeps unfold none, at most `sweeps`. Starts from the folded ones
+    /// among `b`'s elements: what [`Self::unfold`] left there, or those about some
+    /// vertices ([`Self::elements_about`]).
     pub(crate) fn untangle(
         &self,
         fat: &mut FatSolver,
