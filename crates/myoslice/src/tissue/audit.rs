@@ -35,9 +35,10 @@ pub struct TissueAudit {
     pub muscles_in_muscles: MuscleOverlap,
     /// Pairs of skin triangles that cross.
     pub skin_crossings: usize,
-    /// Area of skin touching other skin (m²): faces with the skin across from them within
-    /// the contact gap and 1 mm, or passed into the body across from them; each side of a
-    /// contact counts its own (None when the skin cannot be closed into a mesh).
+    /// Area of skin touching other skin (m²): triangles with the skin across from them
+    /// within the contact gap and 1 mm, or passed into the body across from them; each
+    /// side of a contact counts its own. Over a run, [`Self::worse`] keeps the most (None
+    /// when the skin cannot be closed into a mesh).
     pub skin_in_contact_m2: Option<f32>,
     /// Smallest and largest muscle volume over its rest volume.
     pub muscle_volume_ratio: [f32; 2],

@@ -134,7 +134,7 @@ impl FatKeepOut {
     /// knee axis (the nearest way out of a vertex deep in the patella can lead behind it),
     /// to its clearance past where it leaves the bone; `pose` gives the bodies' poses
     /// (rotation, translation). A vertex watched against two bones is kept from each in
-    /// turn, in bone order.
+    /// turn, in bone order. Returns the vertices it moved, ascending.
     pub(crate) fn apply(
         &self,
         x: &mut [Vec3],
@@ -142,7 +142,7 @@ impl FatKeepOut {
         sdfs: &[BoneSdf],
         surfaces: &[(BodyId, TriMesh)],
         pose: impl Fn(BodyId) -> (Quat, Vec3) + Sync,
-    ) {
+    ) -> Vec<u32> {
         let xs = &*x;
         let (start, bones, clears, (axis_at, axis)) =
             (&self.start, &self.bones, &self.clears, self.axis);
@@ -198,9 +198,14 @@ impl FatKeepOut {
                 moved.then_some((v, p))
             })
             .collect();
-        for (v, p) in moved.into_iter().flatten() {
-            x[v as usize] = p;
-        }
+        moved
+            .into_iter()
+            .flatten()
+            .map(|(v, p)| {
+                x[v as usize] = p;
+                v
+            })
+            .collect()
     }
 }
 

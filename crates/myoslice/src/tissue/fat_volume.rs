@@ -306,9 +306,12 @@ impl FatVolume {
             let (e, k) = ((c >> 3) as usize, (c & 7) as usize);
             let p = fat.hexes[e].map(|i| fat.x[i as usize]);
             for (corner, rest) in HEX_CORNERS.iter().zip(&self.rest[e]) {
-                if let Some(&(_, g)) = gradient(&p, *corner).iter().find(|(i, _)| *i == k) {
-                    out.push((g, corner_jacobian(&p, *corner), floor * rest, *rest));
-                }
+                // Each vertex is one of four points of four of the eight corners.
+                let Some(i) = corner.iter().position(|&i| i == k) else {
+                    continue;
+                };
+                let g = gradient(&p, *corner)[i].1;
+                out.push((g, corner_jacobian(&p, *corner), floor * rest, *rest));
             }
         }
     }

@@ -73,11 +73,12 @@ impl Tissue {
                 .bone_slide
                 .apply(&mut fat.x, &fat.free, &fixed.bone_sdfs, &fixed.bones, pose);
         };
-        // The skin in front of the knee lifts over bone the fold brings under it.
+        // The skin in front of the knee lifts over bone the fold brings under it (the
+        // vertices it moved).
         let keep_out = |fat: &mut FatSolver| {
             fixed
                 .fat_keep_out
-                .apply(&mut fat.x, &fat.free, &fixed.bone_sdfs, &fixed.bones, pose);
+                .apply(&mut fat.x, &fat.free, &fixed.bone_sdfs, &fixed.bones, pose)
         };
         for it in 0..self.config.iterations {
             self.fat.iterate(k);
@@ -105,11 +106,7 @@ impl Tissue {
             // The skin's keep-out has the last word in front of the knee: the unfolding
             // drew it back down onto the patella by a millimetre or two. What that folds
             // is untangled with the vertices it moved held where it put them.
-            let before = self.fat.x.clone();
-            keep_out(&mut self.fat);
-            let moved: Vec<u32> = (0..before.len() as u32)
-                .filter(|&v| self.fat.x[v as usize] != before[v as usize])
-                .collect();
+            let moved = keep_out(&mut self.fat);
             if !moved.is_empty() {
                 for &v in &moved {
                     self.fat.free[v as usize] = false;
