@@ -15,7 +15,7 @@ fn rigid_motions_leave_no_deformation_and_no_area_change() {
     let mut t = common::tissue_of(&sim);
     let q = Quat::from_axis_angle(Vec3::new(0.2, 1.0, 0.4).normalize(), 0.9);
     let shift = Vec3::new(0.3, -0.1, 0.25);
-    for (x, r) in t.fat.x.iter_mut().zip(&t.fat.rest) {
+    for (x, r) in t.fat.x.iter_mut().zip(t.fat.rest.iter()) {
         *x = q * *r + shift;
     }
     let m = TissueMetrics::measure(&t);
@@ -264,7 +264,12 @@ fn fat_after_flexion_and_rest(mut sim: Simulation) -> (f32, f32, f32, usize) {
     let muscles = t
         .muscles
         .iter()
-        .flat_map(|m| m.current.iter().zip(&m.rest).map(|(p, r)| p.distance(*r)))
+        .flat_map(|m| {
+            m.current
+                .iter()
+                .zip(m.rest.iter())
+                .map(|(p, r)| p.distance(*r))
+        })
         .fold(0.0f32, f32::max);
     let folded = sim.tissue_metrics().unwrap().inverted;
     eprintln!(
@@ -468,6 +473,44 @@ fn a_failed_call_leaves_no_trace_in_the_tissue() {
     assert!(
         bits(&sim) == bits(&twin),
         "what follows is what a twin that never failed does"
+    );
+}
+
+#[test]
+fn a_copy_of_the_tissue_shares_its_model_and_owns_its_state() {
+    // A checkpoint or a step's backup is a clone: what never changes (rest shapes,
+    // elements, surfaces) is shared, what an update changes is the copy's own.
+    let mut sim = Simulation::new(
+        common::phantom_lattice().clone(),
+        SimulationConfig::default(),
+        &MuscleCatalogue::default(),
+    )
+    .unwrap();
+    let copy = sim.clone();
+    for m in common::HAMSTRINGS {
+        sim.set_excitation(m, 1.0).unwrap();
+    }
+    let period = sim.tissue().unwrap().period();
+    sim.step(3.0 * period).unwrap();
+    let (t, c) = (sim.tissue().unwrap(), copy.tissue().unwrap());
+    assert!(std::sync::Arc::ptr_eq(&t.fat.rest, &c.fat.rest));
+    assert!(std::sync::Arc::ptr_eq(&t.fat.hexes, &c.fat.hexes));
+    for (m, n) in t.muscles.iter().zip(&c.muscles) {
+        assert!(std::sync::Arc::ptr_eq(&m.rest, &n.rest));
+        assert!(std::sync::Arc::ptr_eq(&m.triangles, &n.triangles));
+    }
+    assert!(
+        t.fat_vertices() != c.fat_vertices(),
+        "the fat moved in one only"
+    );
+    assert_eq!(
+        c.fat_vertices(),
+        &c.fat.rest[..],
+        "the copy's fat is at rest"
+    );
+    assert!(
+        c.muscles.iter().all(|m| m.current[..] == m.rest[..]),
+        "the copy's muscles are at rest"
     );
 }
 

@@ -227,7 +227,7 @@ impl Tissue {
         let per: Vec<(bool, f32)> = fat
             .hexes
             .par_iter()
-            .zip(&fat.rest_volume)
+            .zip(&fat.rest_volume[..])
             .map(|(h, &v0)| {
                 let r = (f64::from(hex_volume_f32(&fat.x, h)) / v0) as f32;
                 (!hex_is_valid(&fat.x, h), r)
@@ -239,7 +239,7 @@ impl Tissue {
         let off_rest: Vec<f32> = fat
             .x
             .par_iter()
-            .zip(&fat.rest)
+            .zip(&fat.rest[..])
             .zip(&self.fixed.thigh_side)
             .map(|((x, r), &thigh)| {
                 let body = if thigh { BodyId::Thigh } else { BodyId::Shank };

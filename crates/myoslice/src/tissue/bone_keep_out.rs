@@ -186,29 +186,7 @@ pub(crate) struct BoneKeepOut {
     skipped: usize,
 }
 
-/// What a [`BoneKeepOut`] carries from one update to the next: the rings' shifts and what
-/// each watched pair knew (a walk starts where the last one ended and may stop at a local
-/// nearest point, so a failed update must give this back too for the run to replay).
-#[derive(Debug, Clone)]
-pub(crate) struct KeepOutMemory {
-    shift: Vec<Vec3>,
-    watch: Vec<Watch>,
-}
-
 impl BoneKeepOut {
-    /// What the next update starts from.
-    pub(crate) fn memory(&self) -> KeepOutMemory {
-        KeepOutMemory {
-            shift: self.shift.clone(),
-            watch: self.watch.clone(),
-        }
-    }
-
-    /// Puts back what [`Self::memory`] took.
-    pub(crate) fn recall(&mut self, m: KeepOutMemory) {
-        (self.shift, self.watch) = (m.shift, m.watch);
-    }
-
     /// Pairs every vertex of `rest` with each bone within [`NEAR_M`] of it
     /// ([`NEAR_KNEE_M`] near the knee point, the point of `rest_contact`). A vertex
     /// already inside a bone at rest (where the slices let muscle and bone overlap) is

@@ -9,6 +9,8 @@
 //! goals into a buffer over the compact vertex range it touches, and the buffers are
 //! summed in chunk order. Chunks are fixed, so results do not depend on the thread count.
 
+use std::sync::Arc;
+
 use crate::par::*;
 use glam::{Quat, Vec3, Vec3A};
 
@@ -20,8 +22,8 @@ const BLOCK: usize = 2048;
 /// Elements per chunk of the element pass (a multiple of [`LANES`]).
 const CHUNK: usize = 512;
 
-/// Consecutive elements, the vertices they touch, and the goal sums over those.
-#[derive(Debug, Clone)]
+/// Consecutive elements and the vertices they touch.
+#[derive(Debug)]
 struct Chunk {
     /// Elements `first..first + len`.
     first: usize,
@@ -30,10 +32,6 @@ struct Chunk {
     verts: Vec<u32>,
     /// Each element's corners as indices into `verts`.
     local: Vec<[u16; 8]>,
-    /// Σ goals per vertex of `verts` (scratch).
-    sum: Vec<Vec3A>,
-    /// Whether any element of the chunk was active in the last pass.
-    used: bool,
 }
 
 impl Chunk {
@@ -52,28 +50,27 @@ impl Chunk {
         Self {
             first,
             len,
-            sum: vec![Vec3A::ZERO; verts.len()],
             verts,
             local,
-            used: false,
         }
     }
 }
 
-/// The shape-matching state of a hexahedral lattice.
+/// A chunk's goal sums in a pass.
 #[derive(Debug, Clone)]
-pub struct FatSolver {
-    /// Rest vertex positions.
-    pub rest: Vec<Vec3>,
-    /// Current vertex positions.
-    pub x: Vec<Vec3>,
-    /// Hexahedra (vertex indices).
-    pub hexes: Vec<[u32; 8]>,
+struct ChunkSum {
+    /// Σ goals per vertex of the chunk's `verts`.
+    sum: Vec<Vec3A>,
+    /// Whether any element of the chunk was active in the last pass.
+    used: bool,
+}
+
+/// What a solver's lattice fixes for good: shared by its copies.
+#[derive(Debug)]
+struct FatMesh {
     /// Rest corners relative to each element's rest centroid, four elements per group
     /// as SIMD lanes (the kernel's layout).
     rest4: Vec<RestLanes>,
-    /// Current rotation of each element (warm start).
-    pub rot: Vec<Quat>,
     /// Element chunks of the scatter.
     chunks: Vec<Chunk>,
     /// 1 / number of elements at each vertex (0 for none).
@@ -84,13 +81,31 @@ pub struct FatSolver {
     /// Vertex → element corners (`hex * 8 + corner`), CSR.
     inc_start: Vec<u32>,
     inc: Vec<u32>,
+}
+
+/// The shape-matching state of a hexahedral lattice. A copy shares the lattice (rest
+/// shape, elements, their layout) and owns the changing state (positions, rotations,
+/// what is relaxed): a backup or checkpoint is a clone.
+#[derive(Debug, Clone)]
+pub struct FatSolver {
+    /// Rest vertex positions.
+    pub rest: Arc<[Vec3]>,
+    /// Current vertex positions.
+    pub x: Vec<Vec3>,
+    /// Hexahedra (vertex indices).
+    pub hexes: Arc<[[u32; 8]]>,
+    /// Volume of each element at rest (m³).
+    pub rest_volume: Arc<[f64]>,
+    mesh: Arc<FatMesh>,
+    /// Goal sums of each chunk of [`FatMesh::chunks`].
+    sums: Vec<ChunkSum>,
+    /// Current rotation of each element (warm start).
+    pub rot: Vec<Quat>,
     /// Whether a vertex is moved by the solver (false: set by a constraint, or outside
     /// the region being relaxed).
     pub free: Vec<bool>,
     /// Whether an element's goal is computed (every element touching a free vertex).
     pub active: Vec<bool>,
-    /// Volume of each element at rest (m³).
-    pub rest_volume: Vec<f64>,
 }
 
 impl FatSolver {
@@ -115,19 +130,29 @@ impl FatSolver {
                 n => 1.0 / n as f32,
             })
             .collect();
+        let sums = chunks
+            .iter()
+            .map(|c| ChunkSum {
+                sum: vec![Vec3A::ZERO; c.verts.len()],
+                used: false,
+            })
+            .collect();
         Self {
             rest_volume,
-            rest: rest.to_vec(),
+            rest: rest.into(),
             x: rest.to_vec(),
-            hexes: hexes.to_vec(),
-            rest4,
+            hexes: hexes.into(),
+            mesh: Arc::new(FatMesh {
+                rest4,
+                chunks,
+                inv_count,
+                block_start,
+                block_chunks,
+                inc_start: count,
+                inc,
+            }),
+            sums,
             rot: vec![Quat::IDENTITY; hexes.len()],
-            chunks,
-            inv_count,
-            block_start,
-            block_chunks,
-            inc_start: count,
-            inc,
             free: vec![true; rest.len()],
             active: vec![true; hexes.len()],
         }
@@ -184,8 +209,9 @@ impl FatSolver {
             "a free vertex has an inactive element"
         );
         self.scatter_goals();
-        let (free, inv) = (&self.free, &self.inv_count);
-        let (chunks, start, list) = (&self.chunks, &self.block_start, &self.block_chunks);
+        let mesh = &*self.mesh;
+        let (free, inv, sums) = (&self.free, &mesh.inv_count, &self.sums);
+        let (chunks, start, list) = (&mesh.chunks, &mesh.block_start, &mesh.block_chunks);
         self.x
             .par_chunks_mut(BLOCK)
             .enumerate()
@@ -194,13 +220,13 @@ impl FatSolver {
                 // Σ goals of this block's vertices, chunk by chunk in order (deterministic).
                 let mut acc = [Vec3A::ZERO; BLOCK];
                 for &ci in &list[start[b] as usize..start[b + 1] as usize] {
-                    let c = &chunks[ci as usize];
-                    if !c.used {
+                    let (c, cs) = (&chunks[ci as usize], &sums[ci as usize]);
+                    if !cs.used {
                         continue;
                     }
                     let from = c.verts.partition_point(|&v| (v as usize) < base);
                     let to = c.verts.partition_point(|&v| (v as usize) < base + xs.len());
-                    for (v, g) in c.verts[from..to].iter().zip(&c.sum[from..to]) {
+                    for (v, g) in c.verts[from..to].iter().zip(&cs.sum[from..to]) {
                         acc[*v as usize - base] += *g;
                     }
                 }
@@ -218,25 +244,27 @@ impl FatSolver {
     /// trigonometry-free step per pass, placed at its centroid), summed per vertex into
     /// its chunk's buffer.
     fn scatter_goals(&mut self) {
-        let (x, hexes, rest4, active) = (&self.x, &self.hexes, &self.rest4, &self.active);
+        let mesh = &*self.mesh;
+        let (x, hexes, rest4, active) = (&self.x, &self.hexes, &mesh.rest4, &self.active);
         let rot = &mut self.rot;
         // Each chunk owns its elements' rotations: split them alongside.
-        let mut rots: Vec<&mut [Quat]> = Vec::with_capacity(self.chunks.len());
+        let mut rots: Vec<&mut [Quat]> = Vec::with_capacity(mesh.chunks.len());
         let mut rest = rot.as_mut_slice();
-        for c in &self.chunks {
+        for c in &mesh.chunks {
             let (head, tail) = rest.split_at_mut(c.len);
             rots.push(head);
             rest = tail;
         }
-        self.chunks
-            .par_iter_mut()
+        mesh.chunks
+            .par_iter()
+            .zip(self.sums.par_iter_mut())
             .zip(rots.into_par_iter())
-            .for_each(|(c, rots)| {
-                c.used = active[c.first..c.first + c.len].iter().any(|a| *a);
-                if !c.used {
+            .for_each(|((c, cs), rots)| {
+                cs.used = active[c.first..c.first + c.len].iter().any(|a| *a);
+                if !cs.used {
                     return;
                 }
-                c.sum.iter_mut().for_each(|s| *s = Vec3A::ZERO);
+                cs.sum.iter_mut().for_each(|s| *s = Vec3A::ZERO);
                 for o in (0..c.len).step_by(LANES) {
                     let e = c.first + o;
                     let n = LANES.min(c.len - o);
@@ -249,7 +277,7 @@ impl FatSolver {
                             &mut rots[o..o + n],
                             act,
                             &c.local[o..o + n],
-                            &mut c.sum,
+                            &mut cs.sum,
                         );
                     }
                 }
@@ -261,14 +289,14 @@ impl FatSolver {
     /// leave it as it is). Marks the corners free and every element touching one active.
     pub fn restrict_to(&mut self, moving: &[bool]) {
         self.free.iter_mut().for_each(|f| *f = false);
-        for h in &self.hexes {
+        for h in self.hexes.iter() {
             if h.iter().any(|&v| moving[v as usize]) {
                 for &v in h {
                     self.free[v as usize] = true;
                 }
             }
         }
-        for (a, h) in self.active.iter_mut().zip(&self.hexes) {
+        for (a, h) in self.active.iter_mut().zip(self.hexes.iter()) {
             *a = h.iter().any(|&v| self.free[v as usize]);
         }
     }
@@ -281,8 +309,9 @@ impl FatSolver {
 
     /// The elements with vertex `v` as a corner.
     pub fn elements_of(&self, v: usize) -> impl Iterator<Item = usize> + '_ {
-        let (s, e) = (self.inc_start[v] as usize, self.inc_start[v + 1] as usize);
-        self.inc[s..e].iter().map(|&c| (c >> 3) as usize)
+        let m = &*self.mesh;
+        let (s, e) = (m.inc_start[v] as usize, m.inc_start[v + 1] as usize);
+        m.inc[s..e].iter().map(|&c| (c >> 3) as usize)
     }
 
     /// Rest-relative corner vectors of element `e`.

@@ -469,7 +469,7 @@ mod tests {
         fat.x[v].x += 0.015;
         assert!(folded(&fat) > 0);
         // The grid's bottom face is held.
-        for (f, p) in fat.free.iter_mut().zip(&fat.rest) {
+        for (f, p) in fat.free.iter_mut().zip(fat.rest.iter()) {
             *f = p.z > 0.0;
         }
         let held = |fat: &FatSolver| -> Vec<Vec3> {
@@ -494,7 +494,7 @@ mod tests {
         let v = 1 + 5 * (1 + 4);
         fat.x[v] += Vec3::new(0.015, 0.004, -0.003);
         assert!(folded(&fat) > 0);
-        for (f, p) in fat.free.iter_mut().zip(&fat.rest) {
+        for (f, p) in fat.free.iter_mut().zip(fat.rest.iter()) {
             *f = p.z > 0.0;
         }
         let held: Vec<Vec3> = (0..fat.x.len())
@@ -508,7 +508,7 @@ mod tests {
         c.elements_about(&mut b, &all);
         c.untangle(&mut fat, &mut b, 0.2, 60);
         assert_eq!(folded(&fat), 0);
-        for h in &fat.hexes {
+        for h in fat.hexes.iter() {
             let (j, r) = (corner_jacobians(&fat.x, h), corner_jacobians(&fat.rest, h));
             assert!(
                 j.iter().zip(&r).all(|(j, r)| *j >= 0.2 * r - 1e-12),

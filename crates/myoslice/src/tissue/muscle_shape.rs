@@ -24,25 +24,27 @@ pub(super) const VOLUME_PASSES: usize = 12;
 /// tube (5 mm slices: 6 cm).
 const MERIDIAN_RINGS: usize = 12;
 
-/// Where a ring rides on the chain and how its vertices sit around it.
+/// Where a ring rides on the chain and how its vertices sit around it. A copy shares
+/// what never changes (rest shape, triangles, ring layout) and owns what an update
+/// changes (current vertices, ring poses, keep-out memory).
 #[derive(Debug, Clone)]
 pub struct MuscleShape {
     /// Chain positions at rest.
-    rest_chain: Vec<Vec3>,
+    rest_chain: Arc<[Vec3]>,
     /// Whether each chain segment is belly (not tendon).
-    belly: Vec<bool>,
+    belly: Arc<[bool]>,
     /// Segment and fraction along it of each ring's centre.
-    ring_param: Vec<(u32, f32)>,
+    ring_param: Arc<[(u32, f32)]>,
     /// Ring index of each vertex.
-    pub(super) ring_of: Vec<u32>,
+    pub(super) ring_of: Arc<[u32]>,
     /// First surface vertex of each ring; a ring's vertices are consecutive.
-    pub(super) ring_first: Vec<u32>,
+    pub(super) ring_first: Arc<[u32]>,
     /// Surface vertices per ring.
     pub(super) ring_len: u32,
     /// Centre vertex of each ring.
-    pub(super) ring_centre: Vec<u32>,
+    pub(super) ring_centre: Arc<[u32]>,
     /// First and last ring of each ring's tube (a muscle may be several tubes).
-    pub(super) tube_of_ring: Vec<(u32, u32)>,
+    pub(super) tube_of_ring: Arc<[(u32, u32)]>,
     /// Each ring's outline in its rest plane (for [`super::muscle_contact`]).
     pub(super) outline: Arc<Vec<RingOutline>>,
     /// How each ring sits now, as the last placement left it.
@@ -54,18 +56,18 @@ pub struct MuscleShape {
     /// took (see [`super::muscle_contact::free_to_bulge`]); empty: all.
     pub(super) bulges: Arc<Vec<bool>>,
     /// Axial offset and perpendicular offset of each vertex in its segment's rest frame.
-    axial: Vec<f32>,
-    perp: Vec<Vec3>,
+    axial: Arc<[f32]>,
+    perp: Arc<[Vec3]>,
     /// Current vertex positions (world, m).
     pub current: Vec<Vec3>,
     /// Rest vertex positions.
-    pub rest: Vec<Vec3>,
+    pub rest: Arc<[Vec3]>,
     /// Enclosed volume at rest (m³).
     pub rest_volume: f64,
     /// Enclosed volume of the current shape (m³), as its last placement measured it.
     pub volume_now: f64,
     /// Surface triangles (from the lattice).
-    pub triangles: Vec<[u32; 3]>,
+    pub triangles: Arc<[[u32; 3]]>,
     /// The rings' shifts out of bone and back to their side of the contact plane.
     pub(crate) keep: BoneKeepOut,
 }
@@ -139,20 +141,20 @@ impl MuscleShape {
             pose: Vec::new(),
             bulges: Arc::default(),
             carried: None,
-            rest_chain,
-            belly,
-            ring_param,
-            ring_of,
+            rest_chain: rest_chain.into(),
+            belly: belly.into(),
+            ring_param: ring_param.into(),
+            ring_of: ring_of.into(),
             ring_first: mesh.rings.iter().map(|r| r.first).collect(),
             ring_len: n,
-            tube_of_ring: tube_of_ring(mesh),
-            axial,
-            perp,
+            tube_of_ring: tube_of_ring(mesh).into(),
+            axial: axial.into(),
+            perp: perp.into(),
             current: mesh.vertices.clone(),
-            rest: mesh.vertices.clone(),
+            rest: mesh.vertices.as_slice().into(),
             rest_volume: mesh.volume().abs(),
             volume_now: mesh.volume().abs(),
-            triangles: mesh.triangles.clone(),
+            triangles: mesh.triangles.as_slice().into(),
             keep: BoneKeepOut::default(),
         };
         shape.carry(Quat::IDENTITY, Vec3::ZERO);
@@ -352,7 +354,7 @@ impl MuscleShape {
                 *p = c + axis_now * (self.axial[vi] * lambda) + m * (self.perp[vi] * across[ring]);
             }
             if let Some(c) = contact {
-                for (p, r) in self.current.iter_mut().zip(&self.rest) {
+                for (p, r) in self.current.iter_mut().zip(self.rest.iter()) {
                     *p = c.apply(*p, r.z >= knee.point.z, c.muscle_margin);
                 }
             }
@@ -413,7 +415,7 @@ impl MuscleShape {
     /// Moves the whole shape rigidly with a body (rest → now).
     pub fn carry(&mut self, q: Quat, t: Vec3) {
         let m = Mat3::from_quat(q);
-        for (p, r) in self.current.iter_mut().zip(&self.rest) {
+        for (p, r) in self.current.iter_mut().zip(self.rest.iter()) {
             *p = m * *r + t;
         }
         self.carry_poses(q, t, &[]);
@@ -436,7 +438,12 @@ impl MuscleShape {
             })
             .collect();
         let shift = &self.keep.shift;
-        for ((p, r), &ring) in self.current.iter_mut().zip(&self.rest).zip(&self.ring_of) {
+        for ((p, r), &ring) in self
+            .current
+            .iter_mut()
+            .zip(self.rest.iter())
+            .zip(self.ring_of.iter())
+        {
             let (sh, a) = (shift[ring as usize], axes[ring as usize]);
             *p = m * *r + t + (sh - a * sh.dot(a));
         }
@@ -470,7 +477,7 @@ impl MuscleShape {
             let Some(fix) = volume_fix(self.rest_volume, v, pass) else {
                 break;
             };
-            for (p, &ring) in self.current.iter_mut().zip(&self.ring_of) {
+            for (p, &ring) in self.current.iter_mut().zip(self.ring_of.iter()) {
                 let (c, a) = (centres[ring as usize], axes[ring as usize]);
                 let o = *p - c;
                 let along = a * o.dot(a);
@@ -555,24 +562,24 @@ mod tests {
             ring_of.extend([r; 4]);
         }
         MuscleShape {
-            rest_chain: Vec::new(),
-            belly: Vec::new(),
-            ring_param: Vec::new(),
-            ring_of,
+            rest_chain: Arc::default(),
+            belly: Arc::default(),
+            ring_param: Arc::default(),
+            ring_of: ring_of.into(),
             ring_first: (0..9).map(|r| 4 * r).collect(),
             ring_len: 4,
             tube_of_ring: (0..9)
                 .map(|r| if r < 6 { (0, 5) } else { (6, 8) })
                 .collect(),
-            axial: Vec::new(),
-            perp: Vec::new(),
-            rest: current.clone(),
+            axial: Arc::default(),
+            perp: Arc::default(),
+            rest: current.as_slice().into(),
             current,
             rest_volume: 0.0,
             volume_now: 0.0,
-            triangles: Vec::new(),
+            triangles: Arc::default(),
             keep: BoneKeepOut::default(),
-            ring_centre: Vec::new(),
+            ring_centre: Arc::default(),
             outline: Arc::default(),
             pose: Vec::new(),
             bulges: Arc::default(),

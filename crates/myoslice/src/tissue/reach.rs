@@ -75,7 +75,7 @@ impl Tissue {
         let surfaces: Vec<(&[Vec3], &[[u32; 3]])> = self
             .muscles
             .iter()
-            .map(|m| (m.current.as_slice(), m.triangles.as_slice()))
+            .map(|m| (m.current.as_slice(), m.triangles.as_ref()))
             .collect();
         muscle_overlaps(&surfaces)
     }
