@@ -51,7 +51,8 @@ impl Simulation {
         let start = Instant::now();
         // The muscles save what a step changes into buffers kept from call to call, the
         // skeleton its joint state (a clone of the rapier world would cost a seventh of a
-        // 1 ms step), the tissue its changing state before its first update in the call.
+        // 1 ms step), the tissue a copy of itself (its model shared) before its first
+        // update in the call.
         let mut rollback = std::mem::take(&mut self.rollback);
         rollback.muscles.save(&self.muscles);
         let skeleton = self.skeleton.snapshot();

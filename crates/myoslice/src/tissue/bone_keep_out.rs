@@ -10,6 +10,8 @@
 //! would otherwise rise with the shank past the plane that holds the fat apart and come
 //! out through the skin of the crease; a bone wins over the plane.
 
+use std::sync::Arc;
+
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::BoundingVolume;
 use parry3d::query::PointQueryWithLocation;
@@ -156,15 +158,16 @@ struct Watch {
 /// and each ring's shift.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct BoneKeepOut {
-    /// (muscle vertex, bone index) pairs near enough at rest to meet.
-    pairs: Vec<(u32, u32)>,
+    /// (muscle vertex, bone index) pairs near enough at rest to meet (fixed: shared by
+    /// copies).
+    pairs: Arc<[(u32, u32)]>,
     /// What each pair knew at its last check.
     watch: Vec<Watch>,
     /// Vertices near the knee kept on their side of the contact plane: (vertex, how far
     /// on its side it was at rest (m, negative past it), whether the side is the
     /// thigh's). None need keep further from the plane than at rest, unless the skin over
-    /// it is further ([`Bones::cover`]).
-    plane: Vec<(u32, f32, bool)>,
+    /// it is further ([`Bones::cover`]). Fixed: shared by copies.
+    plane: Arc<[(u32, f32, bool)]>,
     /// Shift of each ring (world, m).
     pub(crate) shift: Vec<Vec3>,
     /// Work buffers: the shift each ring needs this update, and that spread to its
@@ -249,7 +252,7 @@ impl BoneKeepOut {
             }
         }
         Self {
-            pairs,
+            pairs: pairs.into(),
             watch,
             plane,
             shift: vec![Vec3::ZERO; rings],
@@ -448,7 +451,7 @@ impl BoneKeepOut {
             }
         }
         if let Some(c) = &bones.contact {
-            for &(v, rest_d, thigh) in &self.plane {
+            for &(v, rest_d, thigh) in self.plane.iter() {
                 let r = ring_of[v as usize] as usize;
                 if again && self.spread[r] == Vec3::ZERO {
                     continue;

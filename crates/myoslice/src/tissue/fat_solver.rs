@@ -57,12 +57,23 @@ impl Chunk {
 }
 
 /// A chunk's goal sums in a pass.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 struct ChunkSum {
     /// Σ goals per vertex of the chunk's `verts`.
     sum: Vec<Vec3A>,
     /// Whether any element of the chunk was active in the last pass.
     used: bool,
+}
+
+/// The goal sums of every chunk: work buffers, refilled each pass. A copy of a solver
+/// starts without them (they are allocated at its first pass).
+#[derive(Debug, Default)]
+struct ChunkSums(Vec<ChunkSum>);
+
+impl Clone for ChunkSums {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
 }
 
 /// What a solver's lattice fixes for good: shared by its copies.
@@ -98,7 +109,7 @@ pub struct FatSolver {
     pub rest_volume: Arc<[f64]>,
     mesh: Arc<FatMesh>,
     /// Goal sums of each chunk of [`FatMesh::chunks`].
-    sums: Vec<ChunkSum>,
+    sums: ChunkSums,
     /// Current rotation of each element (warm start).
     pub rot: Vec<Quat>,
     /// Whether a vertex is moved by the solver (false: set by a constraint, or outside
@@ -130,13 +141,6 @@ impl FatSolver {
                 n => 1.0 / n as f32,
             })
             .collect();
-        let sums = chunks
-            .iter()
-            .map(|c| ChunkSum {
-                sum: vec![Vec3A::ZERO; c.verts.len()],
-                used: false,
-            })
-            .collect();
         Self {
             rest_volume,
             rest: rest.into(),
@@ -151,7 +155,7 @@ impl FatSolver {
                 inc_start: count,
                 inc,
             }),
-            sums,
+            sums: ChunkSums::default(),
             rot: vec![Quat::IDENTITY; hexes.len()],
             free: vec![true; rest.len()],
             active: vec![true; hexes.len()],
@@ -210,7 +214,7 @@ impl FatSolver {
         );
         self.scatter_goals();
         let mesh = &*self.mesh;
-        let (free, inv, sums) = (&self.free, &mesh.inv_count, &self.sums);
+        let (free, inv, sums) = (&self.free, &mesh.inv_count, &self.sums.0);
         let (chunks, start, list) = (&mesh.chunks, &mesh.block_start, &mesh.block_chunks);
         self.x
             .par_chunks_mut(BLOCK)
@@ -245,6 +249,16 @@ impl FatSolver {
     /// its chunk's buffer.
     fn scatter_goals(&mut self) {
         let mesh = &*self.mesh;
+        if self.sums.0.len() != mesh.chunks.len() {
+            self.sums.0 = mesh
+                .chunks
+                .iter()
+                .map(|c| ChunkSum {
+                    sum: vec![Vec3A::ZERO; c.verts.len()],
+                    used: false,
+                })
+                .collect();
+        }
         let (x, hexes, rest4, active) = (&self.x, &self.hexes, &mesh.rest4, &self.active);
         let rot = &mut self.rot;
         // Each chunk owns its elements' rotations: split them alongside.
@@ -257,7 +271,7 @@ impl FatSolver {
         }
         mesh.chunks
             .par_iter()
-            .zip(self.sums.par_iter_mut())
+            .zip(self.sums.0.par_iter_mut())
             .zip(rots.into_par_iter())
             .for_each(|((c, cs), rots)| {
                 cs.used = active[c.first..c.first + c.len].iter().any(|a| *a);
