@@ -480,12 +480,7 @@ fn a_failed_call_leaves_no_trace_in_the_tissue() {
 fn a_copy_of_the_tissue_shares_its_model_and_owns_its_state() {
     // A checkpoint or a step's backup is a clone: what never changes (rest shapes,
     // elements, surfaces) is shared, what an update changes is the copy's own.
-    let mut sim = Simulation::new(
-        common::phantom_lattice().clone(),
-        SimulationConfig::default(),
-        &MuscleCatalogue::default(),
-    )
-    .unwrap();
+    let mut sim = common::phantom();
     let copy = sim.clone();
     for m in common::HAMSTRINGS {
         sim.set_excitation(m, 1.0).unwrap();
@@ -518,12 +513,7 @@ fn a_copy_of_the_tissue_shares_its_model_and_owns_its_state() {
 fn metrics_read_late_are_those_of_their_update() {
     // Measured when first asked for: a run that reads them after every update and one
     // that reads them only at the end see the same values, bit for bit.
-    let mut eager = Simulation::new(
-        common::phantom_lattice().clone(),
-        SimulationConfig::default(),
-        &MuscleCatalogue::default(),
-    )
-    .unwrap();
+    let mut eager = common::phantom();
     let built = eager.tissue_metrics().unwrap().clone();
     assert_eq!(built.inverted, 0);
     assert!(built.volume_ratio.iter().all(|r| (r - 1.0).abs() < 1e-5));

@@ -6,7 +6,6 @@
 mod common;
 
 use glam::Vec3;
-use myoslice::muscle::MuscleCatalogue;
 use myoslice::prelude::*;
 
 /// Every fat and muscle vertex's bits, the knee angle's and the guard's tally.
@@ -81,12 +80,7 @@ fn the_tissue_gives_the_same_bits_on_one_and_two_threads() {
             .build()
             .unwrap();
         pool.install(|| {
-            let mut sim = Simulation::new(
-                common::phantom_lattice().clone(),
-                SimulationConfig::default(),
-                &MuscleCatalogue::default(),
-            )
-            .unwrap();
+            let mut sim = common::phantom();
             flex(&mut sim, 0.4);
             tissue_bits(&sim)
         })

@@ -203,6 +203,16 @@ pub fn flex_and_back(sim: &mut Simulation, speed: f64, mut check: impl FnMut(&Si
     max_angle
 }
 
+/// The phantom's simulation with the default options.
+pub fn phantom() -> Simulation {
+    Simulation::new(
+        phantom_lattice().clone(),
+        SimulationConfig::default(),
+        &MuscleCatalogue::default(),
+    )
+    .unwrap()
+}
+
 /// The Visible Human leg's simulation with the default options (None without the data).
 pub fn visible_human() -> Option<Simulation> {
     let lattice = vh_lattice()?;
