@@ -149,4 +149,16 @@ mod tests {
         let beside = through.map(|p| p + Vec3::X * 3.0);
         assert!(!cross(t, beside));
     }
+
+    #[test]
+    fn the_closest_point_of_a_triangle_is_found_in_each_region() {
+        let (a, b, c) = (Vec3::ZERO, Vec3::X, Vec3::Y);
+        let near = |p: Vec3| closest_point(p, a, b, c).0;
+        assert!(near(Vec3::new(0.2, 0.2, 1.0)).distance(Vec3::new(0.2, 0.2, 0.0)) < 1e-6);
+        assert_eq!(near(Vec3::new(-1.0, -1.0, 0.3)), a);
+        assert_eq!(near(Vec3::new(2.0, -0.5, 0.0)), b);
+        assert_eq!(near(Vec3::new(-0.5, 2.0, 0.0)), c);
+        assert!(near(Vec3::new(0.5, -1.0, 0.0)).distance(Vec3::new(0.5, 0.0, 0.0)) < 1e-6);
+        assert!(near(Vec3::new(1.0, 1.0, 0.0)).distance(Vec3::new(0.5, 0.5, 0.0)) < 1e-6);
+    }
 }

@@ -14,10 +14,8 @@ use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::BoundingVolume;
-use parry3d::query::PointQueryWithLocation;
 use parry3d::shape::TriMesh;
 
-use super::bone_slide::BoneMesh;
 use super::knee_fold::Contact;
 use super::skin_cover::SkinCover;
 use crate::body::BodyId;
@@ -38,8 +36,6 @@ const PLANE_REACH_M: f32 = 0.20;
 /// How far (m) in front of the knee axis at rest a vertex may lie and still be kept on
 /// its side of the contact plane.
 const PLANE_FRONT_M: f32 = 0.01;
-/// Beyond this distance (m) from the bone a vertex's clear ball is renewed from the tree.
-const TREE_REFRESH_M: f32 = 0.004;
 /// How far (m) beyond the bone surface a pushed ring ends up.
 const MARGIN_M: f32 = 0.001;
 /// Share of a ring's shift given to its neighbours 1, 2, 3... rings away (the surface
@@ -56,13 +52,14 @@ const FADE: f32 = 0.9;
 /// rings were driven up to 19 mm into bone.
 const PLANE_STEP_M: f32 = 0.002;
 
-/// The bones a tissue update sees: surfaces with adjacency, the same as parry meshes (for
-/// the rare global query) and the bodies' poses.
+/// The bones a tissue update sees: their distance fields and surfaces (rest frames) and
+/// the bodies' poses.
 #[derive(Clone, Copy)]
 pub(crate) struct Bones<'a> {
-    pub(crate) meshes: &'a [BoneMesh],
     /// Each bone's distance field (rest frame), for exact measures.
     pub(crate) sdfs: &'a [crate::geometry::BoneSdf],
+    /// Each bone's body and surface as a parry mesh (its tree answers what lies deeper
+    /// than the field is exact).
     pub(crate) surfaces: &'a [(BodyId, TriMesh)],
     pub(crate) frames: &'a BodyFrames,
     /// Share of a ring's shift kept into this update (see [`fade_per_update`]).
@@ -88,70 +85,15 @@ impl Bones<'_> {
     }
 
     /// How far `p` (world) lies inside bone `b`, as the world vector that takes it to the
-    /// surface; None when outside. `w` is what the pair knew at its last check.
-    fn depth(&self, b: usize, p: Vec3, w: &mut Watch) -> Option<Vec3> {
-        let mesh = &self.meshes[b];
-        let (q, t) = self.pose(mesh.body());
+    /// surface; None when outside. Exact at any depth, from the bone's distance field
+    /// (one lookup for most points) and its tree: nothing remembered between calls.
+    fn depth(&self, b: usize, p: Vec3) -> Option<Vec3> {
+        let (body, tree) = &self.surfaces[b];
+        let (q, t) = self.pose(*body);
         let p_rest = q.inverse() * (p - t);
-        // Still within the ball that was clear of the bone at the last check: outside.
-        if p_rest.distance_squared(w.from) < w.clear * w.clear {
-            return None;
-        }
-        // Surely outside by the grid: that ball instead (the walk's start stays where the
-        // last walk ended, near where the vertex was when it last came close).
-        let bound = mesh.clear_bound(p_rest, &self.surfaces[b].1);
-        if bound > 0.0 {
-            (w.from, w.clear) = (p_rest, bound);
-            return None;
-        }
-        let walk = mesh.walk_checked(w.nearest, p_rest, &self.surfaces[b].1);
-        w.nearest = walk.triangle;
-        if walk.inside {
-            w.clear = 0.0;
-            return Some(q * (walk.point - p_rest));
-        }
-        // The walk's nearest point may be only local, so it cannot vouch for a ball. Close
-        // to the bone the ball known before shrinks by how far the vertex has gone (a
-        // walk an update costs little there); further out the tree, searched no further
-        // than the walk's distance, gives a ball that lasts many updates.
-        let d = walk.point.distance(p_rest);
-        let shrunk = (w.clear - p_rest.distance(w.from)).max(0.0);
-        w.clear = shrunk;
-        if d > TREE_REFRESH_M {
-            match self.surfaces[b]
-                .1
-                .project_local_point_and_get_location_with_max_dist(p_rest, false, d)
-            {
-                Some((proj, (tri, _))) => {
-                    let exact = mesh.walk(tri, p_rest);
-                    w.nearest = exact.triangle;
-                    if exact.inside {
-                        w.clear = 0.0;
-                        return Some(q * (exact.point - p_rest));
-                    }
-                    w.clear = exact
-                        .point
-                        .distance(p_rest)
-                        .min(proj.point.distance(p_rest));
-                }
-                // Nothing nearer than the walk's point: it is the nearest.
-                None => w.clear = d,
-            }
-        }
-        w.from = p_rest;
-        None
+        let s = self.sdfs[b].nearest(tree, p_rest, 0.0)?;
+        (s.distance < 0.0).then(|| q * (s.point - p_rest))
     }
-}
-
-/// What a watched pair knew at its last check.
-#[derive(Debug, Clone, Copy)]
-struct Watch {
-    /// The triangle the vertex was nearest (where the next walk starts).
-    nearest: u32,
-    /// Where the vertex was (bone rest frame)...
-    from: Vec3,
-    /// ...and how far from the bone (m): until it has moved that far it cannot be in.
-    clear: f32,
 }
 
 /// Which muscle vertices are watched against which bone and against the contact plane,
@@ -161,8 +103,6 @@ pub(crate) struct BoneKeepOut {
     /// (muscle vertex, bone index) pairs near enough at rest to meet (fixed: shared by
     /// copies).
     pairs: Arc<[(u32, u32)]>,
-    /// What each pair knew at its last check.
-    watch: Vec<Watch>,
     /// Vertices near the knee kept on their side of the contact plane: (vertex, how far
     /// on its side it was at rest (m, negative past it), whether the side is the
     /// thigh's). None need keep further from the plane than at rest, unless the skin over
@@ -200,7 +140,7 @@ impl BoneKeepOut {
         rest: &[Vec3],
         rings: usize,
         bones: &[(BodyId, TriMesh)],
-        meshes: &[BoneMesh],
+        sdfs: &[crate::geometry::BoneSdf],
         rest_contact: &Contact,
     ) -> Self {
         let knee = rest_contact.point;
@@ -219,7 +159,6 @@ impl BoneKeepOut {
             })
             .collect();
         let mut pairs = Vec::new();
-        let mut watch = Vec::new();
         for (b, (_, mesh)) in bones.iter().enumerate() {
             let (aabb, aabb_knee) = (
                 mesh.local_aabb().loosened(NEAR_M),
@@ -234,26 +173,17 @@ impl BoneKeepOut {
                 if !bounds.contains_local_point(p) {
                     continue;
                 }
-                // The tree search gives up beyond `near`: most vertices are far.
-                let Some((proj, (tri, _))) =
-                    mesh.project_local_point_and_get_location_with_max_dist(p, false, near)
-                else {
-                    continue;
-                };
-                let clear = proj.point.distance(p);
-                if clear < near && !meshes[b].walk(tri, p).inside {
+                // Most vertices are far: the field says so in one lookup.
+                if sdfs[b]
+                    .nearest(mesh, p, near)
+                    .is_some_and(|s| s.distance > 0.0 && s.distance < near)
+                {
                     pairs.push((v as u32, b as u32));
-                    watch.push(Watch {
-                        nearest: tri,
-                        from: p,
-                        clear,
-                    });
                 }
             }
         }
         Self {
             pairs: pairs.into(),
-            watch,
             plane,
             shift: vec![Vec3::ZERO; rings],
             need: vec![Vec3::ZERO; rings],
@@ -425,19 +355,19 @@ impl BoneKeepOut {
         self.need.iter_mut().for_each(|n| *n = Vec3::ZERO);
         self.pushes.clear();
         let mut deep: Option<f32> = None;
-        for (&(v, b), w) in self.pairs.iter().zip(&mut self.watch) {
+        for &(v, b) in self.pairs.iter() {
             let r = ring_of[v as usize] as usize;
             if again && self.spread[r] == Vec3::ZERO {
                 continue;
             }
-            if carried == Some(bones.meshes[b as usize].body()) && self.shift[r] == Vec3::ZERO {
+            if carried == Some(bones.surfaces[b as usize].0) && self.shift[r] == Vec3::ZERO {
                 #[cfg(test)]
                 {
                     self.skipped += 1;
                 }
                 continue;
             }
-            let Some(d) = bones.depth(b as usize, current[v as usize], w) else {
+            let Some(d) = bones.depth(b as usize, current[v as usize]) else {
                 continue;
             };
             let (pushes, need) = (&mut self.pushes, &mut self.need);

@@ -19,6 +19,21 @@ fn box_bone(lo: Vec3, hi: Vec3) -> (BodyId, TriMesh) {
     (BodyId::Thigh, crate::tissue::test_shapes::box_mesh(lo, hi))
 }
 
+/// The distance fields of `bones`, as a tissue builds them.
+fn sdfs_of(bones: &[(BodyId, TriMesh)]) -> Vec<crate::geometry::BoneSdf> {
+    bones
+        .iter()
+        .map(|(_, m)| {
+            crate::geometry::BoneSdf::new(
+                m.vertices(),
+                m.indices(),
+                super::super::SDF_CELL_M,
+                super::super::SDF_BAND_M,
+            )
+        })
+        .collect()
+}
+
 /// Rings of 32 vertices round the z axis, `RINGS` of them 2 mm apart from z = 0, with
 /// semi-axes `a` (x) and `b` (y), shifted along z by `dz`.
 const RINGS: usize = 5;
@@ -66,11 +81,10 @@ fn a_ring_a_bone_reaches_into_from_opposite_sides_is_not_pushed_away() {
         Vec3::new(-0.01, -0.01, 0.005),
         Vec3::new(0.01, 0.01, 0.05),
     )];
-    let meshes = [BoneMesh::new(bones[0].0, &bones[0].1)];
+    let sdfs = sdfs_of(&bones);
     let frames = BodyFrames::REST;
     let b = Bones {
-        meshes: &meshes,
-        sdfs: &[],
+        sdfs: &sdfs,
         surfaces: &bones,
         frames: &frames,
         fade: fade_per_update(30.0),
@@ -78,7 +92,7 @@ fn a_ring_a_bone_reaches_into_from_opposite_sides_is_not_pushed_away() {
         cover: None,
     };
     let (rest, ring_of) = rings(0.015, 0.015, 0.0);
-    let fresh = || BoneKeepOut::new(&rest, RINGS, &bones, &meshes, &far_contact());
+    let fresh = || BoneKeepOut::new(&rest, RINGS, &bones, &sdfs, &far_contact());
     let mut keep = fresh();
     assert!(!keep.pairs.is_empty(), "no vertex watched");
     let (flat, _) = rings(0.015, 0.008, 0.012);
@@ -127,7 +141,6 @@ fn rings_past_the_contact_plane_go_back_to_their_side_and_rings_across_it_at_res
     let frames = BodyFrames::REST;
     let rest_plane = level_plane();
     let bones = |contact| Bones {
-        meshes: &[],
         sdfs: &[],
         surfaces: &[],
         frames: &frames,
@@ -237,7 +250,6 @@ fn rings_under_skin_that_faces_the_plane_keep_beneath_it() {
             .fold(f32::NEG_INFINITY, f32::max)
     };
     let with = |cover| Bones {
-        meshes: &[],
         sdfs: &[],
         surfaces: &[],
         frames: &frames,
@@ -271,13 +283,13 @@ fn carried_rings_find_what_fully_checked_rings_find() {
         slab(0.017, 0.045, 0.02),
         (BodyId::Shank, slab(-0.045, -0.02, 0.003).1),
     ];
-    let meshes: Vec<BoneMesh> = bones.iter().map(|(b, m)| BoneMesh::new(*b, m)).collect();
+    let sdfs = sdfs_of(&bones);
     let moved = BodyFrames {
         shank: (Quat::IDENTITY, Vec3::new(0.007, 0.0, 0.0)),
         ..BodyFrames::REST
     };
     let (rest, ring_of) = rings(0.015, 0.015, 0.0);
-    let fresh = || BoneKeepOut::new(&rest, RINGS, &bones, &meshes, &far_contact());
+    let fresh = || BoneKeepOut::new(&rest, RINGS, &bones, &sdfs, &far_contact());
     let (mut carried, mut full) = (fresh(), fresh());
     assert!(
         carried.pairs.iter().any(|&(_, b)| b == 0) && carried.pairs.iter().any(|&(_, b)| b == 1),
@@ -288,8 +300,7 @@ fn carried_rings_find_what_fully_checked_rings_find() {
     for update in 0..160 {
         let frames = if update < 10 { moved } else { BodyFrames::REST };
         let b = Bones {
-            meshes: &meshes,
-            sdfs: &[],
+            sdfs: &sdfs,
             surfaces: &bones,
             frames: &frames,
             fade: fade_per_update(30.0),

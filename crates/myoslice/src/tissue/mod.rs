@@ -8,7 +8,6 @@ mod bone_keep_out;
 mod bone_overlap;
 mod bone_slide;
 mod crease;
-mod distance_grid;
 mod fat_keep_out;
 mod fat_lanes;
 mod fat_on_muscle;
@@ -64,7 +63,7 @@ use crate::geometry::BoneSdf;
 use crate::lattice::{InnerContact, Lattice};
 use crate::muscle::{BodyFrames, MuscleUnit};
 pub use bone_overlap::{BoneOverlap, Overlap};
-use bone_slide::{BoneMesh, BoneSlide};
+use bone_slide::BoneSlide;
 use fat_keep_out::FatKeepOut;
 use guard::Guard;
 
@@ -123,9 +122,7 @@ struct TissueStatic {
     guard_triangles: Vec<[u32; 3]>,
     /// Where the knee fold can bend the fat.
     zone: FoldZone,
-    /// Bone surfaces with adjacency, lattice bone order (the muscles' keep-out walks).
-    bone_meshes: Vec<BoneMesh>,
-    /// The same surfaces as parry meshes (with a tree, for the rare global query).
+    /// Bone surfaces as parry meshes with the body each rides, lattice bone order.
     bones: BoneSurfaces,
     /// Signed distance field of each bone, lattice bone order (rest frame).
     bone_sdfs: Vec<BoneSdf>,
@@ -218,7 +215,6 @@ impl Tissue {
         config: TissueConfig,
     ) -> Result<Self> {
         config.validate()?;
-        let bone_meshes: Vec<BoneMesh> = bones.iter().map(|(b, m)| BoneMesh::new(*b, m)).collect();
         let bone_sdfs: Vec<BoneSdf> = bones
             .par_iter()
             .map(|(_, m)| BoneSdf::new(m.vertices(), m.indices(), SDF_CELL_M, SDF_BAND_M))
@@ -228,7 +224,7 @@ impl Tissue {
             .par_iter()
             .map(|m| {
                 let mut s = MuscleShape::new(&lattice.muscles[m.lattice_index], &m.chain);
-                s.watch_bones(&bones, &bone_meshes, &rest_contact);
+                s.watch_bones(&bones, &bone_sdfs, &rest_contact);
                 s
             })
             .collect();
@@ -330,7 +326,6 @@ impl Tissue {
             zone,
             bone_slide: BoneSlide::new(&on_bone, &fat.vertices, &bone_sdfs, &bones),
             fat_keep_out,
-            bone_meshes,
             bones: Arc::clone(&bones),
             bone_sdfs,
             outer_faces,

@@ -46,7 +46,6 @@ impl Placing<'_> {
             LAYER_GAP * (self.layers as f32 + 1.0),
         );
         let bones = Bones {
-            meshes: &self.fixed.bone_meshes,
             sdfs: &self.fixed.bone_sdfs,
             surfaces: &self.fixed.bones,
             frames,

@@ -236,16 +236,10 @@ impl MuscleShape {
     pub(crate) fn watch_bones(
         &mut self,
         bones: &[(crate::body::BodyId, parry3d::shape::TriMesh)],
-        meshes: &[super::bone_slide::BoneMesh],
+        sdfs: &[crate::geometry::BoneSdf],
         rest_contact: &Contact,
     ) {
-        self.keep = BoneKeepOut::new(
-            &self.rest,
-            self.ring_param.len(),
-            bones,
-            meshes,
-            rest_contact,
-        );
+        self.keep = BoneKeepOut::new(&self.rest, self.ring_param.len(), bones, sdfs, rest_contact);
     }
 
     /// Places every vertex on the chain's current shape. Where the knee fold rules (see

@@ -16,7 +16,6 @@ impl Tissue {
     /// every update).
     pub fn muscles_in_bone(&self, frames: &BodyFrames) -> Vec<BoneOverlap> {
         let bones = Bones {
-            meshes: &self.fixed.bone_meshes,
             sdfs: &self.fixed.bone_sdfs,
             surfaces: &self.fixed.bones,
             frames,
