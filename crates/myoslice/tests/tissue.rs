@@ -231,11 +231,12 @@ fn visible_human_fat_never_inverts_nor_self_intersects_at_three_times_the_speed(
     tissue_never_breaks_on(lattice.clone(), 3.0, (50, 0));
 }
 
-/// After a deep flexion and back, with every muscle relaxed and the knee held straight
-/// for 1.5 s: how far (m) the fat lies from its rest place at most, riding bone and
-/// anywhere, and how far the muscles do; and how many fat elements stay folded.
-fn fat_after_flexion_and_rest(mut sim: Simulation) -> (f32, f32, f32, usize) {
-    common::flex_and_back(&mut sim, 1.0, |_| {});
+/// After a deep flexion and back, with every muscle relaxed, 1 s after the knee is
+/// straight again (within 1°): how far (m) the fat lies from its rest place at most,
+/// riding bone and anywhere, and how far the muscles do; and how many fat elements stay
+/// folded.
+fn fat_after_flexion_and_rest(mut sim: Simulation, speed: f64) -> (f32, f32, f32, usize) {
+    common::flex_and_back(&mut sim, speed, |_| {});
     for m in sim
         .muscle_names()
         .iter()
@@ -244,12 +245,18 @@ fn fat_after_flexion_and_rest(mut sim: Simulation) -> (f32, f32, f32, usize) {
     {
         sim.set_excitation(&m, 0.0).unwrap();
     }
-    sim.step(1.5).unwrap();
-    assert!(
-        sim.knee_angle().to_degrees().abs() < 1.0,
-        "the knee did not come back straight: {:.1}°",
-        sim.knee_angle().to_degrees()
-    );
+    let period = sim.tissue().unwrap().period();
+    let mut waited = 0.0;
+    while sim.knee_angle().to_degrees().abs() >= 1.0 {
+        assert!(
+            waited < 2.0,
+            "the knee did not come back straight: {:.1}°",
+            sim.knee_angle().to_degrees()
+        );
+        sim.step(period).unwrap();
+        waited += period;
+    }
+    sim.step(1.0).unwrap();
     let fat = &sim.lattice().fat;
     let t = sim.tissue().unwrap();
     let off = |v: usize| t.fat_vertices()[v].distance(t.fat.rest[v]);
@@ -273,7 +280,7 @@ fn fat_after_flexion_and_rest(mut sim: Simulation) -> (f32, f32, f32, usize) {
         .fold(0.0f32, f32::max);
     let folded = sim.tissue_metrics().unwrap().inverted;
     eprintln!(
-        "after the flexion and 1.5 s at rest: fat up to {:.2} mm from rest ({:.2} mm riding \
+        "after the flexion and 1 s straight: fat up to {:.2} mm from rest ({:.2} mm riding \
          bone), muscles up to {:.2} mm; {folded} fat elements folded",
         anywhere * 1e3,
         on_bone * 1e3,
@@ -282,18 +289,18 @@ fn fat_after_flexion_and_rest(mut sim: Simulation) -> (f32, f32, f32, usize) {
     (anywhere, on_bone, muscles, folded)
 }
 
-/// The bounds of [`fat_after_flexion_and_rest`]: within 0.5 mm of rest on bone, elsewhere
-/// no further than the muscles it rides (which keep some of their shape), and no element
-/// still folded.
-fn fat_comes_back_to_rest(sim: Simulation) {
-    let (anywhere, on_bone, muscles, folded) = fat_after_flexion_and_rest(sim);
+/// The bounds of [`fat_after_flexion_and_rest`]: every fat and muscle vertex within 2 mm
+/// of its rest place (issue 27's "no lasting damage"), fat riding bone within 0.5 mm, and
+/// no element still folded.
+fn fat_comes_back_to_rest(sim: Simulation, speed: f64) {
+    let (anywhere, on_bone, muscles, folded) = fat_after_flexion_and_rest(sim, speed);
     assert!(
         on_bone < 0.5e-3,
         "fat riding bone {:.2} mm from rest",
         on_bone * 1e3
     );
     assert!(
-        anywhere < muscles + 1e-3,
+        anywhere < 2e-3 && muscles < 2e-3,
         "fat {:.2} mm from rest, muscles {:.2} mm",
         anywhere * 1e3,
         muscles * 1e3
@@ -304,14 +311,26 @@ fn fat_comes_back_to_rest(sim: Simulation) {
 /// Fat sliding on bone comes back to its rest place once the knee is straight: it
 /// once settled on the far side of a condyle and stayed there.
 #[test]
-fn fat_returns_to_rest_after_a_deep_flexion() {
-    fat_comes_back_to_rest(Simulation::phantom(SimulationConfig::default()).unwrap());
+fn the_tissue_is_back_at_rest_a_second_after_a_deep_flexion() {
+    fat_comes_back_to_rest(common::phantom(), 1.0);
 }
 
 #[test]
-fn visible_human_fat_returns_to_rest_after_a_deep_flexion() {
+fn visible_human_tissue_is_back_at_rest_a_second_after_a_deep_flexion() {
     if let Some(sim) = common::visible_human() {
-        fat_comes_back_to_rest(sim);
+        fat_comes_back_to_rest(sim, 1.0);
+    }
+}
+
+#[test]
+fn the_tissue_is_back_at_rest_a_second_after_a_fast_deep_flexion() {
+    fat_comes_back_to_rest(common::phantom(), 3.0);
+}
+
+#[test]
+fn visible_human_tissue_is_back_at_rest_a_second_after_a_fast_deep_flexion() {
+    if let Some(sim) = common::visible_human() {
+        fat_comes_back_to_rest(sim, 3.0);
     }
 }
 
@@ -343,7 +362,7 @@ fn muscles_are_kept_out_of_bone_through_a_deep_flexion() {
     // pushing rings as far as it wanted at once, 595 vertices, 19 mm; with the rounds
     // stopped by the count of vertices over 1 mm in, not by their depth, and at most 8 of
     // them, 215 vertices, 9.5 mm. Depths from the walk over the bone's triangles that
-    // remembered where it last ended: 185, 7.5 mm; from the distance field: 208, 7.6 mm
+    // remembered where it last ended: 185, 7.5 mm; from the distance field: 201, 7.6 mm
     // (the deepest behind the knee at 137°, squeezed between femur and tibia).
     assert!(
         added < 230 && deepest < 0.009,
@@ -359,7 +378,7 @@ fn visible_human_muscles_are_kept_out_of_bone_through_a_deep_flexion() {
     };
     let (at_rest, added, deepest) = muscles_in_bone_through_a_deep_flexion(sim);
     assert!(
-        // 296, 12.3 mm (the plantaris behind the knee at 137°; the walk: 307, 11.2 mm).
+        // 273, 12.3 mm (the plantaris behind the knee at 137°; the walk: 307, 11.2 mm).
         at_rest == 0 && added < 320 && deepest < 0.013,
         "{at_rest} muscle vertices > 1 mm inside bone at rest, at most {added} more, the \
          deepest {:.1} mm",

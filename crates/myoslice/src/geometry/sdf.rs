@@ -15,6 +15,9 @@ use parry3d::shape::TriMesh;
 
 use super::triangle::{Feature, closest_point};
 
+/// √3: a grid cell's diagonal over its side.
+const SQRT_3: f32 = 1.732_050_8;
+
 /// What a distance query found.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SdfSample {
@@ -117,6 +120,14 @@ impl BoneSdf {
     /// Grid node count along each axis.
     pub fn dims(&self) -> [usize; 3] {
         [self.dims.x, self.dims.y, self.dims.z].map(|d| d as usize)
+    }
+
+    /// A lower bound on the distance (m) from `p` (rest frame) to the surface, outside
+    /// it: positive only where `p` lies surely outside, by at least that much (the
+    /// interpolated distance less a cell's diagonal). `None` outside the grid.
+    #[inline]
+    pub fn clearance(&self, p: Vec3) -> Option<f32> {
+        self.interpolated(p).map(|d| d - SQRT_3 * self.cell)
     }
 
     /// How far from the surface (m) the field's nodes hold exact distances.
@@ -273,10 +284,11 @@ impl BoneSdf {
         inside
     }
 
-    /// The signed distance and outward normal at `p` (rest frame); `None` outside the
-    /// grid, which reaches `band` beyond the surface everywhere.
+    /// The cell of the grid holding `p`: its eight nodes (x fastest), their distances,
+    /// where `p` lies in it (0 to 1 per axis) and the distance interpolated there. `None`
+    /// outside the grid.
     #[inline]
-    pub fn sample(&self, p: Vec3) -> Option<SdfSample> {
+    fn cell_of(&self, p: Vec3) -> Option<([usize; 8], [f32; 8], Vec3, f32)> {
         let g = (p - self.origin) * self.inv_cell;
         let base = g.floor();
         let i = base.as_ivec3();
@@ -299,15 +311,27 @@ impl BoneSdf {
             n000 + sx + sy + sz,
         ];
         let d = idx.map(|n| self.dist[n]);
+        let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
+        let y0 = lerp(lerp(d[0], d[1], f.x), lerp(d[2], d[3], f.x), f.y);
+        let y1 = lerp(lerp(d[4], d[5], f.x), lerp(d[6], d[7], f.x), f.y);
+        Some((idx, d, f, lerp(y0, y1, f.z)))
+    }
+
+    /// The signed distance at `p` (rest frame) interpolated between the grid's nodes
+    /// (exact at them, within a fraction of a cell between them on a smooth surface):
+    /// the cheap query, for decisions that tolerate that; `None` outside the grid.
+    #[inline]
+    pub fn interpolated(&self, p: Vec3) -> Option<f32> {
+        self.cell_of(p).map(|c| c.3)
+    }
+
+    /// The signed distance and outward normal at `p` (rest frame); `None` outside the
+    /// grid, which reaches `band` beyond the surface everywhere.
+    #[inline]
+    pub fn sample(&self, p: Vec3) -> Option<SdfSample> {
+        let (idx, d, f, trilinear) = self.cell_of(p)?;
         let (fx, fy, fz) = (f.x, f.y, f.z);
         let lerp = |a: f32, b: f32, t: f32| a + (b - a) * t;
-        let x00 = lerp(d[0], d[1], fx);
-        let x10 = lerp(d[2], d[3], fx);
-        let x01 = lerp(d[4], d[5], fx);
-        let x11 = lerp(d[6], d[7], fx);
-        let y0 = lerp(x00, x10, fy);
-        let y1 = lerp(x01, x11, fy);
-        let trilinear = lerp(y0, y1, fz);
         if trilinear.abs() > self.exact_within() {
             let gx = lerp(
                 lerp(d[1] - d[0], d[3] - d[2], fy),
@@ -393,6 +417,12 @@ impl BoneSdf {
     /// from the field alone where it can tell (the interpolated distance a cell or more
     /// beyond `within`, or outside the grid), so most far points cost one lookup.
     pub fn nearest(&self, tree: &TriMesh, p: Vec3, within: f32) -> Option<SurfacePoint> {
+        // The nodes hold exact distances and a distance changes no faster than the
+        // point moves, so the interpolated one is within a cell's diagonal of the true:
+        // beyond that, farther than `within` for sure, with no triangle looked at.
+        if self.clearance(p).is_some_and(|d| d > within) {
+            return None;
+        }
         let sample = self.sample(p);
         if let Some(s) = sample {
             if let Some(point) = s.nearest

@@ -47,6 +47,11 @@ const PUSH_ROUNDS: usize = 16;
 /// Share of a ring's shift kept over a thirtieth of a second (one update at the default
 /// rate).
 const FADE: f32 = 0.9;
+/// How far (m) a ring's vertex may reach into a bone or past its place by the contact
+/// plane, placed without the ring's shift, for the shift to go (the rounds push it out of
+/// what is left): placements are not exact to the bit, and a plane that asked a
+/// micrometre held the plantaris's rings 11 mm off rest for good.
+const RELEASE_TOLERANCE_M: f32 = 0.0005;
 /// Most the contact plane asks of a vertex (m) in one round (its ring moves across the
 /// muscle up to twice that): asked as far as it wanted at once, at deep flexion the
 /// rings were driven up to 19 mm into bone.
@@ -86,13 +91,39 @@ impl Bones<'_> {
 
     /// How far `p` (world) lies inside bone `b`, as the world vector that takes it to the
     /// surface; None when outside. Exact at any depth, from the bone's distance field
-    /// (one lookup for most points) and its tree: nothing remembered between calls.
-    fn depth(&self, b: usize, p: Vec3) -> Option<Vec3> {
+    /// (one lookup for most points) and its tree. `ball` (rest frame) is known to lie
+    /// outside the bone: a point in it needs no lookup, and the check leaves there the
+    /// ball it finds clear about `p`.
+    fn depth(&self, b: usize, p: Vec3, ball: &mut (Vec3, f32)) -> Option<Vec3> {
         let (body, tree) = &self.surfaces[b];
         let (q, t) = self.pose(*body);
         let p_rest = q.inverse() * (p - t);
-        let s = self.sdfs[b].nearest(tree, p_rest, 0.0)?;
+        if p_rest.distance_squared(ball.0) < ball.1 * ball.1 {
+            return None;
+        }
+        let sdf = &self.sdfs[b];
+        // Off the field's grid is further than its band from the bone.
+        let clear = sdf.clearance(p_rest).unwrap_or(sdf.band());
+        if clear > 0.0 {
+            *ball = (p_rest, clear);
+            return None;
+        }
+        let s = sdf.nearest(tree, p_rest, f32::INFINITY)?;
+        *ball = (p_rest, s.distance.max(0.0));
         (s.distance < 0.0).then(|| q * (s.point - p_rest))
+    }
+
+    /// Whether `p` (world) lies more than `depth` (m) inside bone `b` by the distance
+    /// interpolated in its field (one lookup; see [`crate::geometry::BoneSdf::interpolated`]),
+    /// or not at all if it lies in `ball` (see [`Self::depth`]).
+    fn deeper_than(&self, b: usize, p: Vec3, depth: f32, ball: (Vec3, f32)) -> bool {
+        let (body, _) = &self.surfaces[b];
+        let (q, t) = self.pose(*body);
+        let p_rest = q.inverse() * (p - t);
+        p_rest.distance_squared(ball.0) >= ball.1 * ball.1
+            && self.sdfs[b]
+                .interpolated(p_rest)
+                .is_some_and(|d| d < -depth)
     }
 }
 
@@ -100,9 +131,9 @@ impl Bones<'_> {
 /// and each ring's shift.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct BoneKeepOut {
-    /// (muscle vertex, bone index) pairs near enough at rest to meet (fixed: shared by
-    /// copies).
-    pairs: Arc<[(u32, u32)]>,
+    /// (muscle vertex, bone index, how far the vertex lay from the bone at rest, m)
+    /// for pairs near enough at rest to meet (fixed: shared by copies).
+    pairs: Arc<[(u32, u32, f32)]>,
     /// Vertices near the knee kept on their side of the contact plane: (vertex, how far
     /// on its side it was at rest (m, negative past it), whether the side is the
     /// thigh's). None need keep further from the plane than at rest, unless the skin over
@@ -124,6 +155,13 @@ pub(crate) struct BoneKeepOut {
     /// Work buffer: the last shift bones alone asked of each ring this update (zero if
     /// none; the contact plane may not push against it).
     bone_push: Vec<Vec3>,
+    /// Per pair, a ball in the bone's rest frame (centre, radius) that lay outside the
+    /// bone at the last check (by the distance field's bound, or the exact distance): a
+    /// vertex still in it is taken as outside with no lookup. Part of the state: it
+    /// spares most lookups (without it, placing the muscles took half as long again),
+    /// and where the field's sign and the nearest triangle's disagree near the surface
+    /// an empty one can decide differently.
+    balls: Vec<(Vec3, f32)>,
     /// Checks [`Self::clear_carried_rings`] skipped (tests only).
     #[cfg(test)]
     skipped: usize,
@@ -174,15 +212,16 @@ impl BoneKeepOut {
                     continue;
                 }
                 // Most vertices are far: the field says so in one lookup.
-                if sdfs[b]
-                    .nearest(mesh, p, near)
-                    .is_some_and(|s| s.distance > 0.0 && s.distance < near)
+                if let Some(s) = sdfs[b].nearest(mesh, p, near)
+                    && s.distance > 0.0
+                    && s.distance < near
                 {
-                    pairs.push((v as u32, b as u32));
+                    pairs.push((v as u32, b as u32, s.distance));
                 }
             }
         }
         Self {
+            balls: vec![(Vec3::ZERO, 0.0); pairs.len()],
             pairs: pairs.into(),
             plane,
             shift: vec![Vec3::ZERO; rings],
@@ -260,6 +299,7 @@ impl BoneKeepOut {
         self.moved.clear();
         self.moved.resize(self.shift.len(), Vec3::ZERO);
         self.bone_push.iter_mut().for_each(|b| *b = Vec3::ZERO);
+        self.release(current, ring_of, &axis, bones);
         let mut last = f32::INFINITY;
         for round in 0..PUSH_ROUNDS {
             let again = round > 0;
@@ -282,48 +322,104 @@ impl BoneKeepOut {
         &self.moved
     }
 
-    /// Records in `pushes` and `need` a push of ring `r` (axis `a`) by `d`, the world
-    /// vector that clears what one of its vertices reaches into (with [`MARGIN_M`] more
-    /// for a bone), and adds its length to `deep` if over 1 mm. The ring moves across its axis
-    /// as far as clears along `d`, at most twice `d`. For the contact plane (`plane`) a
-    /// push within 30° of the axis is no push at all.
+    /// Drops the shift of every shifted ring that would be clear without it, as would
+    /// the rings near it that share their shifts ([`SPREAD`]): each of their watched
+    /// vertices outside its bone and on its side of the contact plane, placed where the
+    /// ring's chain puts it. A shift is kept only while something asks for it: fading
+    /// alone, a ring that the bone had pushed over to its far side (the plantaris over
+    /// the femur's condyle at deep flexion) was pushed back out there update after
+    /// update and never came back to rest.
+    fn release(
+        &mut self,
+        current: &mut [Vec3],
+        ring_of: &[u32],
+        axis: impl Fn(usize) -> Vec3,
+        bones: &Bones,
+    ) {
+        let shift = &self.shift;
+        if shift.iter().all(|s| *s == Vec3::ZERO) {
+            return;
+        }
+        let across = |r: usize| {
+            let (s, a) = (shift[r], axis(r));
+            s - a * s.dot(a)
+        };
+        // `need` is free until the rounds: here, per ring, whether a shifted ring still
+        // needs its shift (non-zero).
+        let held = &mut self.need;
+        held.iter_mut().for_each(|n| *n = Vec3::ZERO);
+        for (&(v, b, _), &ball) in self.pairs.iter().zip(&self.balls) {
+            let r = ring_of[v as usize] as usize;
+            if shift[r] != Vec3::ZERO
+                && held[r] == Vec3::ZERO
+                && bones.deeper_than(
+                    b as usize,
+                    current[v as usize] - across(r),
+                    RELEASE_TOLERANCE_M,
+                    ball,
+                )
+            {
+                held[r] = Vec3::ONE;
+            }
+        }
+        if let Some(c) = &bones.contact {
+            for &(v, rest_d, thigh) in self.plane.iter() {
+                let r = ring_of[v as usize] as usize;
+                if shift[r] != Vec3::ZERO && held[r] == Vec3::ZERO {
+                    // As the rounds would: a push along the muscle is none.
+                    let d = plane_push(
+                        c,
+                        bones.cover,
+                        current[v as usize] - across(r),
+                        rest_d,
+                        thigh,
+                    );
+                    if d.length() > RELEASE_TOLERANCE_M
+                        && ring_push((d, 0.0), axis(r), true).is_some()
+                    {
+                        held[r] = Vec3::ONE;
+                    }
+                }
+            }
+        }
+        let rings = shift.len();
+        let reach = SPREAD.len();
+        for r in 0..rings {
+            let near = r.saturating_sub(reach)..(r + reach + 1).min(rings);
+            if shift[r] != Vec3::ZERO && held[near].iter().all(|h| *h == Vec3::ZERO) {
+                self.moved[r] = -across(r);
+            }
+        }
+        for (p, &r) in current.iter_mut().zip(ring_of) {
+            *p += self.moved[r as usize];
+        }
+        for (s, m) in self.shift.iter_mut().zip(&self.moved) {
+            if *m != Vec3::ZERO {
+                *s = Vec3::ZERO;
+            }
+        }
+    }
+
+    /// Records in `pushes` and `need` the push of ring `r` ([`ring_push`]) for `d` and
+    /// `margin`, if any, and adds the length of `d` to `deep` if over 1 mm.
     fn add_push(
         pushes: &mut Vec<(u32, Vec3)>,
         need: &mut [Vec3],
         r: usize,
-        d: Vec3,
+        d_margin: (Vec3, f32),
         a: Vec3,
         deep: &mut Option<f32>,
         plane: bool,
     ) {
-        // The plane's allowance already holds the muscles' margin from it.
-        let push = if plane {
-            d
-        } else {
-            d + d.normalize_or_zero() * MARGIN_M
-        };
-        // Across the ring, as far as clears along the push (at most twice its length
-        // where the push runs nearly along the muscle).
-        let across = push - a * push.dot(a);
-        let clears = across.dot(push);
-        let push = if clears > 0.25 * push.length_squared() {
-            across * (push.length_squared() / clears)
-        } else if plane {
-            // Twice the push sideways would not clear the plane, only throw the ring
-            // aside (as at small angles, the plane nearly across the muscle).
+        let Some(push) = ring_push(d_margin, a, plane) else {
             return;
-        } else {
-            across.normalize_or_zero() * (2.0 * push.length())
         };
-        if push == Vec3::ZERO {
-            return; // the push runs along the muscle: nothing across
-        }
         pushes.push((r as u32, push));
         let need = &mut need[r];
         if push.length_squared() > need.length_squared() {
             *need = push;
         }
-        let depth = d.length();
+        let depth = d_margin.0.length();
         *deep = Some(deep.unwrap_or(0.0) + if depth > 1e-3 { depth } else { 0.0 });
     }
 
@@ -355,7 +451,7 @@ impl BoneKeepOut {
         self.need.iter_mut().for_each(|n| *n = Vec3::ZERO);
         self.pushes.clear();
         let mut deep: Option<f32> = None;
-        for &(v, b) in self.pairs.iter() {
+        for (&(v, b, clear), ball) in self.pairs.iter().zip(&mut self.balls) {
             let r = ring_of[v as usize] as usize;
             if again && self.spread[r] == Vec3::ZERO {
                 continue;
@@ -367,11 +463,15 @@ impl BoneKeepOut {
                 }
                 continue;
             }
-            let Some(d) = bones.depth(b as usize, current[v as usize]) else {
+            let Some(d) = bones.depth(b as usize, current[v as usize], ball) else {
                 continue;
             };
+            // Out to its rest distance from the bone, if that is less than the margin: a
+            // vertex pushed further than it lay at rest moves its ring, wrapped round the
+            // bone, into it on the other side, update after update.
             let (pushes, need) = (&mut self.pushes, &mut self.need);
-            Self::add_push(pushes, need, r, d, axis(r), &mut deep, false);
+            let margin = MARGIN_M.min(clear);
+            Self::add_push(pushes, need, r, (d, margin), axis(r), &mut deep, false);
         }
         // Then the contact plane, which may not push a ring against the way a bone
         // pushed it this update (a bone wins).
@@ -386,15 +486,11 @@ impl BoneKeepOut {
                 if again && self.spread[r] == Vec3::ZERO {
                     continue;
                 }
-                let p = current[v as usize];
-                let mut margin = c.muscle_margin.min(rest_d);
-                if let Some(cover) = bones.cover {
-                    margin = margin.max(cover.floor(p, thigh));
-                }
-                let d = (c.apply(p, thigh, margin) - p).clamp_length_max(PLANE_STEP_M);
+                let d = plane_push(c, bones.cover, current[v as usize], rest_d, thigh);
                 if d != Vec3::ZERO && d.dot(self.bone_push[r]) >= 0.0 {
                     let (pushes, need) = (&mut self.pushes, &mut self.need);
-                    Self::add_push(pushes, need, r, d, axis(r), &mut deep, true);
+                    // The plane's allowance already holds the muscles' margin from it.
+                    Self::add_push(pushes, need, r, (d, 0.0), axis(r), &mut deep, true);
                 }
             }
         }
@@ -441,6 +537,37 @@ impl BoneKeepOut {
         }
         deep
     }
+}
+
+/// The shift of a ring (axis `a`) that takes one of its vertices `d` out of what it
+/// reaches into, and `margin` (m) further: across the axis, as far as clears along `d`,
+/// at most twice as far as `d`. None if the push runs along the muscle, or for the
+/// contact plane (`plane`) within 30° of it.
+fn ring_push((d, margin): (Vec3, f32), a: Vec3, plane: bool) -> Option<Vec3> {
+    let push = d + d.normalize_or_zero() * margin;
+    let across = push - a * push.dot(a);
+    let clears = across.dot(push);
+    let push = if clears > 0.25 * push.length_squared() {
+        across * (push.length_squared() / clears)
+    } else if plane {
+        // Twice the push sideways would not clear the plane, only throw the ring aside
+        // (as at small angles, the plane nearly across the muscle).
+        return None;
+    } else {
+        across.normalize_or_zero() * (2.0 * push.length())
+    };
+    (push != Vec3::ZERO).then_some(push)
+}
+
+/// How far the contact plane `c` moves vertex `p` (at most [`PLANE_STEP_M`] a round),
+/// which lay `rest_d` on its side of it at rest (`thigh`: the thigh's side), under the
+/// skin `cover`.
+fn plane_push(c: &Contact, cover: Option<&SkinCover>, p: Vec3, rest_d: f32, thigh: bool) -> Vec3 {
+    let mut margin = c.muscle_margin.min(rest_d);
+    if let Some(cover) = cover {
+        margin = margin.max(cover.floor(p, thigh));
+    }
+    (c.apply(p, thigh, margin) - p).clamp_length_max(PLANE_STEP_M)
 }
 
 #[cfg(test)]

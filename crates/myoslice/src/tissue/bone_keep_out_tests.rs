@@ -34,6 +34,22 @@ fn sdfs_of(bones: &[(BodyId, TriMesh)]) -> Vec<crate::geometry::BoneSdf> {
         .collect()
 }
 
+/// `bones` (with their fields `sdfs`) at `frames`, with no contact plane, at 30 Hz.
+fn bones_at<'a>(
+    sdfs: &'a [crate::geometry::BoneSdf],
+    bones: &'a [(BodyId, TriMesh)],
+    frames: &'a BodyFrames,
+) -> Bones<'a> {
+    Bones {
+        sdfs,
+        surfaces: bones,
+        frames,
+        fade: fade_per_update(30.0),
+        contact: None,
+        cover: None,
+    }
+}
+
 /// Rings of 32 vertices round the z axis, `RINGS` of them 2 mm apart from z = 0, with
 /// semi-axes `a` (x) and `b` (y), shifted along z by `dz`.
 const RINGS: usize = 5;
@@ -83,14 +99,7 @@ fn a_ring_a_bone_reaches_into_from_opposite_sides_is_not_pushed_away() {
     )];
     let sdfs = sdfs_of(&bones);
     let frames = BodyFrames::REST;
-    let b = Bones {
-        sdfs: &sdfs,
-        surfaces: &bones,
-        frames: &frames,
-        fade: fade_per_update(30.0),
-        contact: None,
-        cover: None,
-    };
+    let b = bones_at(&sdfs, &bones, &frames);
     let (rest, ring_of) = rings(0.015, 0.015, 0.0);
     let fresh = || BoneKeepOut::new(&rest, RINGS, &bones, &sdfs, &far_contact());
     let mut keep = fresh();
@@ -292,21 +301,15 @@ fn carried_rings_find_what_fully_checked_rings_find() {
     let fresh = || BoneKeepOut::new(&rest, RINGS, &bones, &sdfs, &far_contact());
     let (mut carried, mut full) = (fresh(), fresh());
     assert!(
-        carried.pairs.iter().any(|&(_, b)| b == 0) && carried.pairs.iter().any(|&(_, b)| b == 1),
+        carried.pairs.iter().any(|&(_, b, _)| b == 0)
+            && carried.pairs.iter().any(|&(_, b, _)| b == 1),
         "both bones watched"
     );
     let mut deepest_shift = 0.0f32;
     let mut skipped_pushed = 0;
     for update in 0..160 {
         let frames = if update < 10 { moved } else { BodyFrames::REST };
-        let b = Bones {
-            sdfs: &sdfs,
-            surfaces: &bones,
-            frames: &frames,
-            fade: fade_per_update(30.0),
-            contact: None,
-            cover: None,
-        };
+        let b = bones_at(&sdfs, &bones, &frames);
         for (keep, own) in [(&mut carried, Some(BodyId::Thigh)), (&mut full, None)] {
             keep.fade(b.fade);
             let mut current: Vec<Vec3> = rest
@@ -342,4 +345,32 @@ fn carried_rings_find_what_fully_checked_rings_find() {
         "{:?}",
         full.shift
     );
+}
+
+#[test]
+fn a_shift_stays_while_the_bone_needs_it_and_goes_once_the_ring_is_clear_without_it() {
+    // A slab bone 10 mm thick beside the rings (x 18–28 mm, clear of their 15 mm radius).
+    let bones = [box_bone(
+        Vec3::new(0.018, -0.03, -0.01),
+        Vec3::new(0.028, 0.03, 0.02),
+    )];
+    let sdfs = sdfs_of(&bones);
+    let frames = BodyFrames::REST;
+    let b = bones_at(&sdfs, &bones, &frames);
+    let (rest, ring_of) = rings(0.015, 0.015, 0.0);
+    let mut keep = BoneKeepOut::new(&rest, RINGS, &bones, &sdfs, &far_contact());
+    assert!(!keep.pairs.is_empty(), "no vertex watched");
+    // Placed 6 mm toward the bone (3 mm into it), the rings are pushed back and keep
+    // that shift update after update while they are placed there.
+    let pressed: Vec<Vec3> = rest.iter().map(|p| *p + Vec3::X * 0.006).collect();
+    run(&mut keep, &pressed, &ring_of, &b, 20);
+    for s in &keep.shift {
+        assert!(s.x < -0.002, "{s:?}");
+    }
+    // Pushed over to the bone's far side (shifted 40 mm along x), rings whose place is
+    // clear drop the shift at once, instead of fading through the bone and being pushed
+    // back out on its far side every update.
+    keep.shift.iter_mut().for_each(|s| *s = Vec3::X * 0.04);
+    let left = run(&mut keep, &rest, &ring_of, &b, 1);
+    assert_eq!(left, 0.0, "a shift of {:.1} mm stayed", left * 1e3);
 }
