@@ -125,6 +125,9 @@ impl SceneMesh {
             }
         }
         s.ranges[0] = start..s.indices.len() as u32;
+        // The tissue's last update carried with the bones to now: it updates at its own
+        // rate, the bones every step.
+        let carried = sim.carried_tissue();
         // Muscles: their deformed shapes when the tissue runs.
         let start = s.indices.len() as u32;
         if opts.visible[1] {
@@ -139,15 +142,18 @@ impl SceneMesh {
                 };
                 let color = [c[0], c[1], c[2], opts.opacity[1]];
                 let from = s.indices.len() as u32;
-                s.push_mesh(&sim.muscle_vertices(i), &lm.mesh.triangles, color);
+                match &carried {
+                    Some(c) => s.push_mesh(&c.muscles[i], &lm.mesh.triangles, color),
+                    None => s.push_mesh(&sim.muscle_vertices(i), &lm.mesh.triangles, color),
+                }
                 s.muscle_ranges.push((i, from..s.indices.len() as u32));
             }
         }
         s.ranges[1] = start..s.indices.len() as u32;
         // Skin: the outer faces of the fat, one flat colour per element.
         let start = s.indices.len() as u32;
-        let fat_x: Vec<Vec3> = match sim.tissue() {
-            Some(t) => t.fat_vertices().to_vec(),
+        let fat_x: Vec<Vec3> = match carried {
+            Some(c) => c.fat,
             None => lat
                 .fat
                 .vertices

@@ -78,7 +78,8 @@ impl BodyFrames {
         shank: (Quat::IDENTITY, Vec3::ZERO),
     };
 
-    fn of(&self, b: BodyId) -> (Quat, Vec3) {
+    /// The pose (rotation, translation) of body `b`.
+    pub fn pose(&self, b: BodyId) -> (Quat, Vec3) {
         match b {
             BodyId::Thigh => self.thigh,
             BodyId::Shank => self.shank,
@@ -87,13 +88,13 @@ impl BodyFrames {
 
     /// A rest point of body `b` in the world now.
     pub fn point(&self, b: BodyId, p: Vec3) -> Vec3 {
-        let (q, t) = self.of(b);
+        let (q, t) = self.pose(b);
         q * p + t
     }
 
     /// A rest direction of body `b` in the world now.
     pub fn vector(&self, b: BodyId, v: Vec3) -> Vec3 {
-        self.of(b).0 * v
+        self.pose(b).0 * v
     }
 }
 
@@ -218,7 +219,7 @@ impl MuscleChain {
         debug_assert_eq!(x.len(), self.cones.len(), "one place per chain point");
         for (p, c) in x.iter().zip(&mut self.cones) {
             if let Some(c) = c {
-                let (q, t) = frames.of(c.body);
+                let (q, t) = frames.pose(c.body);
                 c.rest = q.inverse() * (*p - t);
             }
         }

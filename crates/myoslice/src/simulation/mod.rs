@@ -300,6 +300,13 @@ impl Simulation {
         self.tissue.as_ref()
     }
 
+    /// The fat and muscles of the last tissue update carried with the bones to now (see
+    /// [`Tissue::carried`]): what to draw between updates. None when tissue is disabled.
+    pub fn carried_tissue(&self) -> Option<crate::tissue::CarriedTissue> {
+        self.tissue()
+            .map(|t| t.carried(self.knee_angle(), self.frames()))
+    }
+
     /// Tissue metrics of the last tissue update (None when tissue is disabled).
     pub fn tissue_metrics(&self) -> Option<&TissueMetrics> {
         self.tissue.as_ref().map(Tissue::metrics)

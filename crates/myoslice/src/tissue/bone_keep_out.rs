@@ -83,10 +83,7 @@ pub(crate) fn fade_per_update(rate_hz: f64) -> f32 {
 
 impl Bones<'_> {
     pub(crate) fn pose(&self, body: BodyId) -> (Quat, Vec3) {
-        match body {
-            BodyId::Thigh => self.frames.thigh,
-            BodyId::Shank => self.frames.shank,
-        }
+        self.frames.pose(body)
     }
 
     /// How far `p` (world) lies inside bone `b`, as the world vector that takes it to the

@@ -282,6 +282,15 @@ impl FoldZone {
         }
     }
 
+    /// The weight of vertex `v` in `fold` (see [`KneeFold::weight`]).
+    pub fn weight(&self, fold: &KneeFold, v: usize) -> f32 {
+        match self.kind[v] {
+            THIGH => 0.0,
+            SHANK => 1.0,
+            _ => fold.weight_of(&self.points[v]),
+        }
+    }
+
     /// Whether vertex `v` can bend (else it moves rigidly with its bone).
     pub fn contains(&self, v: usize) -> bool {
         self.kind[v] == ZONE

@@ -7,6 +7,7 @@ mod audit;
 mod bone_keep_out;
 mod bone_overlap;
 mod bone_slide;
+mod carried;
 mod crease;
 mod fat_keep_out;
 mod fat_lanes;
@@ -42,6 +43,7 @@ use glam::{Quat, Vec3};
 use parry3d::shape::TriMesh;
 
 pub use audit::{AuditLine, TissueAudit};
+pub use carried::CarriedTissue;
 pub use fat_solver::FatSolver;
 pub use guard_tally::GuardTally;
 pub use knee_fold::{Contact, FoldZone, KneeFold};
@@ -187,7 +189,9 @@ pub struct Tissue {
     drift: Vec<Vec3>,
     scratch: Scratch,
     knee: KneeAxis,
+    /// The knee angle (rad) and the bodies' poses at the last update.
     theta: f32,
+    frames_at_update: BodyFrames,
     layers: usize,
     /// Metrics of the last update (see [`Self::metrics`]).
     metrics: LazyMetrics,
@@ -341,6 +345,7 @@ impl Tissue {
             scratch: Scratch::default(),
             knee,
             theta: 0.0,
+            frames_at_update: BodyFrames::REST,
             layers: fat.layers,
             metrics: LazyMetrics::built(),
             guard_tally: GuardTally::default(),
@@ -548,6 +553,7 @@ impl Tissue {
         };
         self.relax(&constraints, &mut sc.volume, (&mut phases, &mut lap));
         self.theta = theta;
+        self.frames_at_update = *frames;
         self.scratch = sc;
         Front {
             phases,
