@@ -255,9 +255,13 @@ class Simulation:
     def moment_arms(self) -> npt.NDArray[np.float64]:
         """Moment arm of every muscle about the knee (m, positive flexing)."""
 
-    def surface(self, layer: str) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint32]]:
+    def surface(
+        self, layer: str, *, carried: bool = False
+    ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint32]]:
         """Vertices (float32 ``(N, 3)``, m) and triangles (uint32 ``(M, 3)``) of a layer
-        now: ``"bone"``, ``"muscle"`` or ``"skin"``."""
+        now: ``"bone"``, ``"muscle"`` or ``"skin"``. Muscles and skin are as the last
+        tissue update left them, or with ``carried`` carried with the bones from it to
+        now (what the viewer draws between updates)."""
 
     @property
     def area_change(self) -> npt.NDArray[np.float32]:

@@ -449,11 +449,25 @@ impl PySimulation {
     }
 
     /// Vertices (float32, (N, 3), m) and triangles (uint32, (M, 3)) of a layer now:
-    /// "bone", "muscle" or "skin".
-    fn surface<'py>(&self, py: Python<'py>, layer: &str) -> PyResult<SurfaceArrays<'py>> {
+    /// "bone", "muscle" or "skin". Muscles and skin are as the last tissue update left
+    /// them, or with `carried` carried with the bones from it to now (what the viewer
+    /// draws between updates).
+    #[pyo3(signature = (layer, *, carried = false))]
+    fn surface<'py>(
+        &self,
+        py: Python<'py>,
+        layer: &str,
+        carried: bool,
+    ) -> PyResult<SurfaceArrays<'py>> {
         let layer: Layer = layer.parse().or_py(py)?;
         let sim = &self.sim;
-        let surface = crate::pool::detach(py, move || sim.surface(layer));
+        let surface = crate::pool::detach(py, move || {
+            if carried {
+                sim.carried_surface(layer)
+            } else {
+                sim.surface(layer)
+            }
+        });
         Ok((
             vec3_array(py, &surface.vertices),
             tri_array(py, &surface.triangles),

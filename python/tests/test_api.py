@@ -183,6 +183,31 @@ def test_surface_follows_the_knee(rigid: Simulation) -> None:
     assert not np.array_equal(before, after)
 
 
+def test_carried_surface_moves_the_tissue_with_the_bones_between_updates(
+    tissue: Simulation, rigid: Simulation
+) -> None:
+    flex(tissue, 0.2)
+    differed = 0
+    for _ in range(40):  # more than a tissue period (30 Hz)
+        tissue.step(0.001)
+        skin, tris = tissue.surface("skin")
+        carried, carried_tris = tissue.surface("skin", carried=True)
+        assert carried.shape == skin.shape and np.array_equal(carried_tris, tris)
+        differed += int(not np.array_equal(carried, skin))
+        # Within the knee's turn in a period (the foot's end moves centimetres in a
+        # fast flexion), not a different leg.
+        assert float(np.abs(carried - skin).max()) < 0.15
+    # Between updates the knee moves on and the carried skin with it; at an update the
+    # two are the same.
+    assert 0 < differed < 40
+    assert np.array_equal(tissue.surface("bone", carried=True)[0], tissue.surface("bone")[0])
+    muscles = tissue.surface("muscle", carried=True)[0]
+    assert muscles.shape == tissue.surface("muscle")[0].shape
+    # Without tissue there is nothing to carry.
+    flex(rigid, 0.2)
+    assert np.array_equal(rigid.surface("skin", carried=True)[0], rigid.surface("skin")[0])
+
+
 # --- stepping and excitations --------------------------------------------------------
 
 

@@ -9,6 +9,7 @@ use super::Simulation;
 use crate::body::body_of_bone;
 use crate::error::{Error, Result};
 use crate::lattice::FatLattice;
+use crate::tissue::CarriedTissue;
 
 /// A surface layer of the body.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -124,7 +125,7 @@ impl Simulation {
             .map_or(&self.lattice().fat.vertices[..], |t| t.fat_vertices())
     }
 
-    /// One layer's surface now.
+    /// One layer's surface now: the tissue's layers as its last update left them.
     ///
     /// ```no_run
     /// use myoslice::prelude::*;
@@ -135,6 +136,20 @@ impl Simulation {
     /// # Ok::<(), myoslice::Error>(())
     /// ```
     pub fn surface(&self, layer: Layer) -> Surface {
+        self.surface_with(layer, None)
+    }
+
+    /// [`Self::surface`] with the tissue's layers carried with the bones from its last
+    /// update to now ([`Self::carried_tissue`]): what the viewer draws between updates.
+    pub fn carried_surface(&self, layer: Layer) -> Surface {
+        let carried = match layer {
+            Layer::Bone => None,
+            Layer::Muscle | Layer::Skin => self.carried_tissue(),
+        };
+        self.surface_with(layer, carried.as_ref())
+    }
+
+    fn surface_with(&self, layer: Layer, carried: Option<&CarriedTissue>) -> Surface {
         let lat = self.lattice();
         let mut s = Surface::default();
         match layer {
@@ -145,15 +160,16 @@ impl Simulation {
             }
             Layer::Muscle => {
                 for (i, m) in self.muscles().iter().enumerate() {
-                    s.push(
-                        &self.muscle_vertices(i),
-                        &lat.muscles[m.lattice_index].mesh.triangles,
-                    );
+                    let triangles = &lat.muscles[m.lattice_index].mesh.triangles;
+                    match carried {
+                        Some(c) => s.push(&c.muscles[i], triangles),
+                        None => s.push(&self.muscle_vertices(i), triangles),
+                    }
                 }
             }
             Layer::Skin => {
                 let (used, triangles) = lat.fat.skin_mesh();
-                let x = self.fat_vertices();
+                let x = carried.map_or_else(|| self.fat_vertices(), |c| &c.fat[..]);
                 s.vertices = used.iter().map(|&i| x[i as usize]).collect();
                 s.triangles = triangles;
             }
