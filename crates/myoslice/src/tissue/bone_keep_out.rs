@@ -86,6 +86,12 @@ impl Bones<'_> {
         self.frames.pose(body)
     }
 
+    /// `p` (world) in the rest frame of bone `b`.
+    pub(crate) fn rest_point(&self, b: usize, p: Vec3) -> Vec3 {
+        let (q, t) = self.pose(self.surfaces[b].0);
+        q.inverse() * (p - t)
+    }
+
     /// How far `p` (world) lies inside bone `b`, as the world vector that takes it to the
     /// surface; None when outside. Exact at any depth, from the bone's distance field
     /// (one lookup for most points) and its tree. `ball` (rest frame) is known to lie
@@ -93,8 +99,8 @@ impl Bones<'_> {
     /// ball it finds clear about `p`.
     fn depth(&self, b: usize, p: Vec3, ball: &mut (Vec3, f32)) -> Option<Vec3> {
         let (body, tree) = &self.surfaces[b];
-        let (q, t) = self.pose(*body);
-        let p_rest = q.inverse() * (p - t);
+        let q = self.pose(*body).0;
+        let p_rest = self.rest_point(b, p);
         if p_rest.distance_squared(ball.0) < ball.1 * ball.1 {
             return None;
         }
@@ -114,9 +120,7 @@ impl Bones<'_> {
     /// interpolated in its field (one lookup; see [`crate::geometry::BoneSdf::interpolated`]),
     /// or not at all if it lies in `ball` (see [`Self::depth`]).
     fn deeper_than(&self, b: usize, p: Vec3, depth: f32, ball: (Vec3, f32)) -> bool {
-        let (body, _) = &self.surfaces[b];
-        let (q, t) = self.pose(*body);
-        let p_rest = q.inverse() * (p - t);
+        let p_rest = self.rest_point(b, p);
         p_rest.distance_squared(ball.0) >= ball.1 * ball.1
             && self.sdfs[b]
                 .interpolated(p_rest)
