@@ -13,6 +13,7 @@ mod fat_keep_out;
 mod fat_lanes;
 mod fat_on_muscle;
 pub mod fat_solver;
+mod fat_untangle;
 mod fat_volume;
 mod guard;
 mod guard_tally;

@@ -101,7 +101,7 @@ impl Tissue {
             // their neighbours in the squeezed inner layer) each vertex untangles heeding
             // all its elements at once.
             if volume.unfold(&mut self.fat, buffers, CORNER_FLOOR, FINAL_UNFOLD_SWEEPS) > 0 {
-                volume.untangle(&mut self.fat, buffers, CORNER_FLOOR, FINAL_UNFOLD_SWEEPS);
+                volume.untangle(&mut self.fat, buffers, FINAL_UNFOLD_SWEEPS);
             }
             // The skin's keep-out has the last word in front of the knee: the unfolding
             // drew it back down onto the patella by a millimetre or two. What that folds
@@ -112,7 +112,7 @@ impl Tissue {
                     self.fat.free[v as usize] = false;
                 }
                 volume.elements_about(buffers, &moved);
-                volume.untangle(&mut self.fat, buffers, CORNER_FLOOR, FINAL_UNFOLD_SWEEPS);
+                volume.untangle(&mut self.fat, buffers, FINAL_UNFOLD_SWEEPS);
                 // Free again: the keep-out only holds them for this untangling.
                 for &v in &moved {
                     self.fat.free[v as usize] = true;
