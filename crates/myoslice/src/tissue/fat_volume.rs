@@ -281,6 +281,28 @@ impl FatVolume {
         }
     }
 
+    /// Untangles the elements about `moved` with those vertices held where they were
+    /// put (by a pass with the last word on them), then frees them again.
+    pub(crate) fn untangle_holding(
+        &self,
+        fat: &mut FatSolver,
+        b: &mut VolumeBuffers,
+        moved: &[u32],
+        sweeps: usize,
+    ) {
+        if moved.is_empty() {
+            return;
+        }
+        for &v in moved {
+            fat.free[v as usize] = false;
+        }
+        self.elements_about(b, moved);
+        self.untangle(fat, b, sweeps);
+        for &v in moved {
+            fat.free[v as usize] = true;
+        }
+    }
+
     /// The corner tetrahedra vertex `v` takes part in (of all its elements), into
     /// `terms`; returns the smallest corner Jacobian among them relative to its rest one.
     fn vertex_terms(

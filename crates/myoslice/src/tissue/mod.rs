@@ -31,6 +31,7 @@ mod reach;
 mod relax;
 mod skin_breach;
 mod skin_cover;
+mod skin_pleat;
 #[cfg(test)]
 mod test_shapes;
 mod tissue_backup;

@@ -6,7 +6,9 @@
 //! iteration the sliding on bone; and in the last three the skin's keep-out from bone and
 //! the fat's volume and corners ([`super::fat_volume`]). The update ends with the
 //! unfolding swept until it gains nothing more, then the untangling of what it left
-//! (vertex by vertex), so the last word is the fat's validity.
+//! (vertex by vertex); then the skin's keep-out from bone and the stacking of its pleats
+//! ([`super::skin_pleat`]), each followed by the untangling of what it folded with the
+//! vertices it moved held, so the last word is the fat's validity.
 //! Without them, as before: shape matching with the pull and the contact, then the bone
 //! passes and the contact once each after the iterations
 //! (they folded hundreds of fat elements at deep flexion, docs/tissue-history.md).
@@ -107,17 +109,10 @@ impl Tissue {
             // drew it back down onto the patella by a millimetre or two. What that folds
             // is untangled with the vertices it moved held where it put them.
             let moved = keep_out(&mut self.fat);
-            if !moved.is_empty() {
-                for &v in &moved {
-                    self.fat.free[v as usize] = false;
-                }
-                volume.elements_about(buffers, &moved);
-                volume.untangle(&mut self.fat, buffers, FINAL_UNFOLD_SWEEPS);
-                // Free again: the keep-out only holds them for this untangling.
-                for &v in &moved {
-                    self.fat.free[v as usize] = true;
-                }
-            }
+            volume.untangle_holding(&mut self.fat, buffers, &moved, FINAL_UNFOLD_SWEEPS);
+            // Then the skin's pleats are stacked, and what that folds untangled likewise.
+            let moved = self.stack_pleats(c.contact);
+            volume.untangle_holding(&mut self.fat, buffers, &moved, FINAL_UNFOLD_SWEEPS);
         } else {
             slide(&mut self.fat);
             keep_out(&mut self.fat);
