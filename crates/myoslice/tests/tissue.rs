@@ -136,10 +136,10 @@ fn muscle_volume_is_conserved_through_a_deep_flexion_of_the_visible_human_leg() 
 /// and `folded.1` once the knee is straight again. Returns the largest knee angle after
 /// an update.
 ///
-/// The folds are a regression bound, not a goal: the fat's own constraints unfold all but
-/// 17–37 at the deepest flexion (420–590 before them) (where the skin behind the knee crosses itself and
-/// the guard falls back toward the knee fold, see docs/tissue-history.md), and none are
-/// left with the knee straight again.
+/// The folds are a regression bound, not a goal: the fat's own constraints, its
+/// untangling and the stacking of the skin's pleats leave 3–9 at the worst update (22 at
+/// a third of the tissue rate; 17–37 before the last two, 420–590 before the
+/// constraints, see docs/tissue-history.md), and none with the knee straight again.
 fn tissue_never_breaks(mut sim: Simulation, speed: f64, folded: (usize, usize)) -> f64 {
     let tri = sim.lattice().fat.surface_triangles();
     let mut worst = common::Breaks {
@@ -192,12 +192,12 @@ fn tissue_never_breaks_on(lattice: Lattice, speed: f64, folded: (usize, usize)) 
 
 #[test]
 fn fat_never_inverts_nor_self_intersects_through_a_deep_flexion() {
-    tissue_never_breaks_on(common::phantom_lattice().clone(), 1.0, (50, 0));
+    tissue_never_breaks_on(common::phantom_lattice().clone(), 1.0, (15, 0));
 }
 
 #[test]
 fn fat_never_inverts_nor_self_intersects_at_three_times_the_speed() {
-    tissue_never_breaks_on(common::phantom_lattice().clone(), 3.0, (50, 0));
+    tissue_never_breaks_on(common::phantom_lattice().clone(), 3.0, (15, 0));
 }
 
 /// The README's table of tissue rates offers a third of the default rate as a trade of
@@ -207,7 +207,7 @@ fn fat_never_inverts_nor_self_intersects_at_a_third_of_the_tissue_rate() {
     let mut cfg = SimulationConfig::default();
     cfg.tissue.rate_hz /= 3.0;
     let sim = Simulation::phantom(cfg).unwrap();
-    let max = tissue_never_breaks(sim, 1.0, (50, 0));
+    let max = tissue_never_breaks(sim, 1.0, (30, 0));
     // Updates 0.1 s apart fall at most at 123° of the flexion's 134°.
     assert!(
         max > 120.0,
@@ -220,7 +220,7 @@ fn visible_human_fat_never_inverts_nor_self_intersects_through_a_deep_flexion() 
     let Some(lattice) = common::vh_lattice() else {
         return;
     };
-    tissue_never_breaks_on(lattice.clone(), 1.0, (50, 0));
+    tissue_never_breaks_on(lattice.clone(), 1.0, (15, 0));
 }
 
 #[test]
@@ -228,7 +228,7 @@ fn visible_human_fat_never_inverts_nor_self_intersects_at_three_times_the_speed(
     let Some(lattice) = common::vh_lattice() else {
         return;
     };
-    tissue_never_breaks_on(lattice.clone(), 3.0, (50, 0));
+    tissue_never_breaks_on(lattice.clone(), 3.0, (15, 0));
 }
 
 /// After a deep flexion and back, with every muscle relaxed, 1 s after the knee is
