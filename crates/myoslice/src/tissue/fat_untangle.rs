@@ -51,17 +51,29 @@ pub(crate) fn delta_squared(sigma_min: f64) -> f64 {
     }
 }
 
+/// The smallest σ (Jacobian over its rest value) among the corner tetrahedra of an
+/// element (its corners `now` and at `rest`) that contain its corner `k`: what sets δ
+/// (see [`delta_squared`]) before [`push_terms`] builds them.
+pub(crate) fn sigma_min(now: &[Vec3; 8], rest: &[Vec3; 8], k: usize) -> f64 {
+    let det = |p: [DVec3; 4]| DMat3::from_cols(p[1] - p[0], p[2] - p[0], p[3] - p[0]).determinant();
+    HEX_CORNERS
+        .iter()
+        .filter(|corner| corner.contains(&k))
+        .map(|corner| {
+            det(corner.map(|i| now[i].as_dvec3())) / det(corner.map(|i| rest[i].as_dvec3()))
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// The corner tetrahedra of an element (its corners `now` and at `rest`) that contain
-/// its corner `k`, appended to `out`, relative to `origin`. Returns the smallest σ among
-/// them.
+/// its corner `k`, appended to `out`, relative to `origin`.
 pub(crate) fn push_terms(
     now: &[Vec3; 8],
     rest: &[Vec3; 8],
     k: usize,
     origin: Vec3,
     out: &mut Vec<CornerTerm>,
-) -> f64 {
-    let mut s_min = f64::INFINITY;
+) {
     for corner in HEX_CORNERS {
         let Some(slot) = corner.iter().position(|&i| i == k) else {
             continue;
@@ -75,16 +87,13 @@ pub(crate) fn push_terms(
         } else {
             rest_inverse.row(slot - 1)
         };
-        let term = CornerTerm {
+        out.push(CornerTerm {
             points,
             slot,
             rest_inverse,
             lever,
-        };
-        s_min = s_min.min(term.sigma(points[slot]));
-        out.push(term);
+        });
     }
-    s_min
 }
 
 impl CornerTerm {
@@ -94,6 +103,7 @@ impl CornerTerm {
         DMat3::from_cols(q[1] - q[0], q[2] - q[0], q[3] - q[0]) * self.rest_inverse
     }
 
+    #[cfg(test)]
     fn sigma(&self, p: DVec3) -> f64 {
         self.shape(p).determinant()
     }
@@ -212,7 +222,18 @@ mod tests {
         now[2] += Vec3::new(0.001, -0.002, 0.0005);
         for k in [0, 2, 6] {
             let mut terms = Vec::new();
-            let s_min = push_terms(&now, &rest, k, now[k], &mut terms);
+            push_terms(&now, &rest, k, now[k], &mut terms);
+            // σ of the terms at the vertex's start is what `sigma_min` gives (to the
+            // rounding of the terms' points, taken about the vertex in single precision).
+            let s_min = terms
+                .iter()
+                .map(|t| t.sigma(t.points[t.slot]))
+                .fold(f64::MAX, f64::min);
+            let direct = sigma_min(&now, &rest, k);
+            assert!(
+                (s_min - direct).abs() <= 1e-5 * s_min.abs().max(1.0),
+                "{s_min} {direct}"
+            );
             let least = delta_squared(s_min - 0.1);
             for delta2 in [least, least + 1e-3] {
                 let p = DVec3::new(1e-4, -2e-4, 5e-5);
@@ -240,8 +261,8 @@ mod tests {
             let mut terms = Vec::new();
             let mut q = now;
             q[6] = p;
-            let s_min = push_terms(&q, &rest, 6, p, &mut terms);
-            let Some(d) = untangle_move(&terms, delta_squared(s_min)) else {
+            push_terms(&q, &rest, 6, p, &mut terms);
+            let Some(d) = untangle_move(&terms, delta_squared(sigma_min(&q, &rest, 6))) else {
                 break;
             };
             p += d;

@@ -52,6 +52,13 @@ pub(crate) struct VolumeBuffers {
     new_x: Vec<Vec3>,
 }
 
+impl VolumeBuffers {
+    /// The elements the last [`FatVolume::untangle`] left folded (ascending), taken out.
+    pub(crate) fn take_folded(&mut self) -> Vec<u32> {
+        std::mem::take(&mut self.elements)
+    }
+}
+
 /// The gradient of corner `c`'s Jacobian with respect to the four points it involves.
 #[inline]
 fn gradient(p: &[Vec3; 8], c: [usize; 4]) -> [(usize, Vec3); 4] {
@@ -228,7 +235,8 @@ impl FatVolume {
     /// after the other in index order; sweeps over the folded elements about what moved
     /// until none is, or [`STALLED_AFTER`] sweeps unfold none, at most `sweeps`. Starts
     /// from the folded ones among `b`'s elements: what [`Self::unfold`] left there, or
-    /// those about some vertices ([`Self::elements_about`]).
+    /// those about some vertices ([`Self::elements_about`]); leaves there the folded
+    /// ones it could not unfold.
     ///
     /// The barrier sits at zero, not at the unfolding's floor: one at the floor weighed a
     /// folded corner no more than one merely under it, and traded the one for the other
@@ -259,10 +267,11 @@ impl FatVolume {
             }
             b.vertices.sort_unstable();
             // One regularisation per sweep, from the worst corner about what moves.
-            let mut s_min = f64::INFINITY;
-            for &v in &b.vertices {
-                s_min = s_min.min(self.vertex_terms(fat, v as usize, &mut terms));
-            }
+            let s_min = b
+                .vertices
+                .iter()
+                .map(|&v| self.vertex_sigma_min(fat, v as usize))
+                .fold(f64::INFINITY, f64::min);
             let delta2 = fat_untangle::delta_squared(s_min);
             for &v in &b.vertices {
                 b.seen[v as usize] = false;
@@ -281,22 +290,23 @@ impl FatVolume {
         }
     }
 
-    /// Untangles the elements about `moved` with those vertices held where they were
-    /// put (by a pass with the last word on them), then frees them again.
+    /// Untangles the elements about `moved` and the elements `also` with the `moved`
+    /// vertices held where they were put (by a pass with the last word on them), then
+    /// frees them again. Leaves in `b` what it left folded ([`VolumeBuffers::take_folded`]).
     pub(crate) fn untangle_holding(
         &self,
         fat: &mut FatSolver,
         b: &mut VolumeBuffers,
-        moved: &[u32],
+        (moved, also): (&[u32], &[u32]),
         sweeps: usize,
     ) {
-        if moved.is_empty() {
-            return;
-        }
         for &v in moved {
             fat.free[v as usize] = false;
         }
         self.elements_about(b, moved);
+        b.elements.extend_from_slice(also);
+        b.elements.sort_unstable();
+        b.elements.dedup();
         self.untangle(fat, b, sweeps);
         for &v in moved {
             fat.free[v as usize] = true;
@@ -304,25 +314,39 @@ impl FatVolume {
     }
 
     /// The corner tetrahedra vertex `v` takes part in (of all its elements), into
-    /// `terms`; returns the smallest corner Jacobian among them relative to its rest one.
-    fn vertex_terms(
-        &self,
-        fat: &FatSolver,
-        v: usize,
-        terms: &mut Vec<fat_untangle::CornerTerm>,
-    ) -> f64 {
+    /// `terms`.
+    fn vertex_terms(&self, fat: &FatSolver, v: usize, terms: &mut Vec<fat_untangle::CornerTerm>) {
         terms.clear();
-        let (s, t) = (self.inc_start[v] as usize, self.inc_start[v + 1] as usize);
         let origin = fat.x[v];
-        let mut s_min = f64::INFINITY;
-        for &c in &self.inc[s..t] {
+        for (now, rest, k) in self.corners_of(fat, v) {
+            fat_untangle::push_terms(&now, &rest, k, origin, terms);
+        }
+    }
+
+    /// The smallest corner Jacobian relative to its rest one among the corner
+    /// tetrahedra vertex `v` takes part in.
+    fn vertex_sigma_min(&self, fat: &FatSolver, v: usize) -> f64 {
+        self.corners_of(fat, v)
+            .map(|(now, rest, k)| fat_untangle::sigma_min(&now, &rest, k))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Each element about vertex `v`: its corners now and at rest, and which is `v`.
+    fn corners_of<'a>(
+        &'a self,
+        fat: &'a FatSolver,
+        v: usize,
+    ) -> impl Iterator<Item = ([Vec3; 8], [Vec3; 8], usize)> + 'a {
+        let (s, t) = (self.inc_start[v] as usize, self.inc_start[v + 1] as usize);
+        self.inc[s..t].iter().map(move |&c| {
             let (e, k) = ((c >> 3) as usize, (c & 7) as usize);
             let h = &fat.hexes[e];
-            let now = h.map(|i| fat.x[i as usize]);
-            let rest = h.map(|i| fat.rest[i as usize]);
-            s_min = s_min.min(fat_untangle::push_terms(&now, &rest, k, origin, terms));
-        }
-        s_min
+            (
+                h.map(|i| fat.x[i as usize]),
+                h.map(|i| fat.rest[i as usize]),
+                k,
+            )
+        })
     }
 
     /// Puts the elements about `vertices` in `b` (ascending, each once), where

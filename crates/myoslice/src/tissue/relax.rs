@@ -8,7 +8,8 @@
 //! unfolding swept until it gains nothing more, then the untangling of what it left
 //! (vertex by vertex); then the skin's keep-out from bone and the stacking of its pleats
 //! ([`super::skin_pleat`]), each followed by the untangling of what it folded with the
-//! vertices it moved held, so the last word is the fat's validity.
+//! vertices it moved held, and a last untangling of what those left, the pleats still
+//! held, so the last word is the fat's validity.
 //! Without them, as before: shape matching with the pull and the contact, then the bone
 //! passes and the contact once each after the iterations
 //! (they folded hundreds of fat elements at deep flexion, docs/tissue-history.md).
@@ -109,10 +110,17 @@ impl Tissue {
             // drew it back down onto the patella by a millimetre or two. What that folds
             // is untangled with the vertices it moved held where it put them.
             let moved = keep_out(&mut self.fat);
-            volume.untangle_holding(&mut self.fat, buffers, &moved, FINAL_UNFOLD_SWEEPS);
+            volume.untangle_holding(&mut self.fat, buffers, (&moved, &[]), FINAL_UNFOLD_SWEEPS);
+            let mut left = buffers.take_folded();
             // Then the skin's pleats are stacked, and what that folds untangled likewise.
             let moved = self.stack_pleats(c.contact);
-            volume.untangle_holding(&mut self.fat, buffers, &moved, FINAL_UNFOLD_SWEEPS);
+            volume.untangle_holding(&mut self.fat, buffers, (&moved, &[]), FINAL_UNFOLD_SWEEPS);
+            // What either left folded is untangled once more, from a fresh start (the
+            // sweeps stop after four that unfold nothing), the pleats still held and the
+            // keep-out's vertices free again: moved by a fraction of a millimetre, they
+            // let no more bone out, and half the folds left go.
+            left.extend(buffers.take_folded());
+            volume.untangle_holding(&mut self.fat, buffers, (&moved, &left), FINAL_UNFOLD_SWEEPS);
         } else {
             slide(&mut self.fat);
             keep_out(&mut self.fat);

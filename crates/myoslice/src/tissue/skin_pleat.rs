@@ -5,13 +5,13 @@
 //! for each pair of crossing skin triangles of the same side the one that lay farther
 //! from the joint at rest goes on top: its vertices move away from the plane, along its
 //! normal, to a skin's thickness past the other's farthest vertex. A few rounds, each
-//! looking again only at the triangles with a vertex still free.
+//! looking again only at the triangles the last one moved.
 //!
 //! Left to the guard, those crossings had it fall back toward the knee fold, which folds
 //! fat elements behind a bent knee (docs/tissue-history.md).
 
 use super::Tissue;
-use super::intersect::crossing_pairs_among;
+use super::intersect::{Aabb, TriangleGrid, crossing_pairs_near};
 use super::knee_fold::Contact;
 
 /// How far (m) a layer of a pleat lies past the one under it, along the plane's normal:
@@ -33,12 +33,29 @@ impl Tissue {
         let from_joint =
             |t: &[u32; 3]| -> f32 { t.iter().map(|&v| rest[v as usize].distance(joint)).sum() };
         let mut moved: Vec<u32> = Vec::new();
-        let live: Vec<bool> = triangles
+        // Only pairs with a live triangle can cross (see the guard): first those with a
+        // free vertex, then those with a vertex the last round moved.
+        let mut live: Vec<bool> = triangles
             .iter()
             .map(|t| t.iter().any(|&v| free[v as usize]))
             .collect();
-        for _ in 0..PLEAT_ROUNDS {
-            let mut pairs = crossing_pairs_among(x, triangles, Some(&live));
+        let mut boxes: Vec<Aabb> = triangles.iter().map(|t| Aabb::of(x, t)).collect();
+        let mut moved_now = vec![false; x.len()];
+        for round in 0..PLEAT_ROUNDS {
+            let query: Vec<u32> = (0..triangles.len() as u32)
+                .filter(|&i| live[i as usize])
+                .collect();
+            if query.is_empty() {
+                break;
+            }
+            let queried = |i: u32| live[i as usize];
+            let mut pairs = if round == 0 {
+                TriangleGrid::new(&boxes, triangles, x).map_or_else(Vec::new, |g| {
+                    g.crossing_pairs(x, triangles, &boxes, &query, queried)
+                })
+            } else {
+                crossing_pairs_near(x, triangles, &boxes, &query, queried)
+            };
             if pairs.is_empty() {
                 break;
             }
@@ -69,9 +86,18 @@ impl Tissue {
                     if free[v] && d < top {
                         x[v] = contact.toward_side(x[v], side, top - d);
                         moved.push(v as u32);
+                        moved_now[v] = true;
                     }
                 }
             }
+            // The next round looks again at the triangles this one moved.
+            for (i, t) in triangles.iter().enumerate() {
+                live[i] = t.iter().any(|&v| moved_now[v as usize]);
+                if live[i] {
+                    boxes[i] = Aabb::of(x, t);
+                }
+            }
+            moved_now.fill(false);
         }
         moved.sort_unstable();
         moved.dedup();
